@@ -1,0 +1,13 @@
+#pragma once
+// The `rigcal` command line: each subcommand lives in its own file and registers itself here.
+// Subcommands talk to people; the library computes, calib/io and calib/rig read and write.
+#include <CLI/CLI.hpp>
+
+namespace rigcal::cli {
+
+// `rigcal rig validate|show|convert`
+void add_rig_validate(CLI::App& rig);
+void add_rig_show(CLI::App& rig);
+void add_rig_convert(CLI::App& rig);
+
+}  // namespace rigcal::cli

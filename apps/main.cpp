@@ -1,0 +1,44 @@
+// rigcal: calibrate a multi-sensor rig, publish the calibration, score trajectories.
+// Exit status: 0 success, 2 bad input or usage (one line on stderr), 1 internal error.
+#include <fmt/format.h>
+
+#include <cstdio>
+#include <exception>
+
+#include "cli.h"
+#include "rigcal/core/error.h"
+#include "rigcal_version.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "rigcal: calibrates a multi-sensor rig (stereo cameras, LiDAR, IMUs, GNSS/INS), publishes\n"
+      "the calibration as YAML, and scores trajectories. Conventions: T_a_b maps points of frame\n"
+      "b into frame a; the base frame is the LiDAR; SI units. See doc/ for every format.",
+      "rigcal"};
+  app.set_version_flag("--version",
+                       fmt::format("rigcal {} ({})", RIGCAL_VERSION, RIGCAL_GIT_REVISION));
+  app.require_subcommand(1);
+  app.footer("Exit status: 0 success, 2 bad input (the message names file, line and key), 1 bug.");
+
+  CLI::App* rig = app.add_subcommand("rig", "Check, show and convert a calibration YAML");
+  rig->require_subcommand(1);
+  rigcal::cli::add_rig_validate(*rig);
+  rigcal::cli::add_rig_show(*rig);
+  rigcal::cli::add_rig_convert(*rig);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) {
+    return app.exit(e);  // --help, --version
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "rigcal: %s (see rigcal --help)\n", e.what());
+    return 2;
+  } catch (const rigcal::Error& e) {
+    std::fprintf(stderr, "rigcal: error: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "rigcal: internal error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,46 @@
+// rigcal rig convert FILE --to FORMAT --out PATH: exports for other tools.
+#include <fmt/format.h>
+
+#include <memory>
+
+#include "cli.h"
+#include "rigcal/rig/export.h"
+#include "rigcal/rig/rig_yaml.h"
+
+namespace rigcal::cli {
+namespace {
+
+struct Options {
+  std::string file, to, out, imu;
+};
+
+}  // namespace
+
+void add_rig_convert(CLI::App& parent) {
+  auto o = std::make_shared<Options>();
+  CLI::App* cmd = parent.add_subcommand(
+      "convert",
+      "Write the rig for another tool (doc/exports.md):\n"
+      "  rigcal  the full rigcal YAML (e.g. to normalise a VBR file)\n"
+      "  vbr     only the keys of the published vbr_calib.yaml\n"
+      "  kalibr  Kalibr camchain (T_cn_cnm1, T_cam_imu, timeshift_cam_imu)\n"
+      "  opencv  cv::FileStorage YAML: K1 D1 K2 D2 R T E F + stereo rectification\n"
+      "  ros     one camera_info YAML per camera into the folder --out\n"
+      "  mrcal   one .cameramodel per camera into the folder --out\n"
+      "Files are written to a temporary name and renamed: a failed run writes nothing.");
+  cmd->add_option("file", o->file, "calibration YAML")->required();
+  cmd->add_option("--to", o->to, "rigcal | vbr | kalibr | opencv | ros | mrcal")->required();
+  cmd->add_option("--out", o->out, "output file (a folder for ros and mrcal)")->required();
+  cmd->add_option("--imu", o->imu,
+                  "kalibr: the IMU for T_cam_imu (default: the sensor 'imu', else the first IMU)");
+  cmd->callback([o] {
+    const rig::ExportFormat format = rig::export_format_from_string(o->to);
+    const rig::Rig r = rig::read_rig_file(o->file);
+    const std::vector<io::OutputFile> files =
+        rig::export_files(r, format, o->out, rig::ExportOptions{o->imu});
+    io::write_files_atomic(files);
+    for (const io::OutputFile& f : files) fmt::print("wrote {} ({})\n", f.path.string(), o->to);
+  });
+}
+
+}  // namespace rigcal::cli

@@ -1,0 +1,25 @@
+#pragma once
+// Small text helpers shared by every reader and writer: strict number parsing and the
+// shortest number text that reads back to the same double.
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace rigcal {
+
+// Splits on runs of spaces, tabs and commas; drops empty fields and a trailing '\r'.
+std::vector<std::string_view> split_fields(std::string_view line);
+
+// Whole-string, finite double (no NaN or infinity). Throws rigcal::Error naming `what`.
+double parse_double(std::string_view text, std::string_view what);
+// Whole-string integer. Throws rigcal::Error naming `what`.
+long long parse_int(std::string_view text, std::string_view what);
+
+// Shortest decimal text that parses back to exactly `value` (lossless like %.17g, but 0.1 stays
+// "0.1"). With `keep_point` the mantissa always has a '.', as YAML 1.1 floats need ("1.0",
+// "1.0e-05").
+std::string format_double(double value, bool keep_point = false);
+
+std::string_view trim(std::string_view s);
+
+}  // namespace rigcal

@@ -1,0 +1,84 @@
+#include "rigcal/io/files.h"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "rigcal/core/error.h"
+
+namespace rigcal::io {
+
+namespace fs = std::filesystem;
+
+std::string read_text_file(const fs::path& path) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) {
+    throw Error(fmt::format("{}: is a folder, expected a file", path.string()));
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw Error(fmt::format("{}: cannot open: {}", path.string(), std::strerror(errno)));
+  }
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) throw Error(fmt::format("{}: read error", path.string()));
+  return ss.str();
+}
+
+fs::path temporary_sibling(const fs::path& path) {
+  static std::atomic<int> counter{0};
+  fs::path tmp = path;
+  tmp += fmt::format(".tmp-{}-{}{}", ::getpid(), counter++, path.extension().string());
+  return tmp;
+}
+
+void write_files_atomic(const std::vector<OutputFile>& files) {
+  std::vector<fs::path> temps;
+  auto cleanup = [&] {
+    std::error_code ec;
+    for (const fs::path& t : temps) fs::remove(t, ec);
+  };
+  try {
+    for (const OutputFile& f : files) {
+      const fs::path parent = f.path.has_parent_path() ? f.path.parent_path() : fs::path(".");
+      std::error_code ec;
+      fs::create_directories(parent, ec);
+      if (ec) {
+        throw Error(fmt::format("{}: cannot create the folder: {}", parent.string(), ec.message()));
+      }
+      if (fs::is_directory(f.path, ec)) {
+        throw Error(fmt::format("{}: is a folder, expected a file path", f.path.string()));
+      }
+      temps.push_back(temporary_sibling(f.path));
+      std::ofstream out(temps.back(), std::ios::binary | std::ios::trunc);
+      if (!out) {
+        throw Error(fmt::format("{}: cannot write: {}", f.path.string(), std::strerror(errno)));
+      }
+      out << f.content;
+      out.flush();
+      if (!out) throw Error(fmt::format("{}: write failed (disk full?)", f.path.string()));
+    }
+    for (size_t i = 0; i < files.size(); ++i) {
+      std::error_code ec;
+      fs::rename(temps[i], files[i].path, ec);
+      if (ec) {
+        throw Error(fmt::format("{}: cannot rename the finished file into place: {}",
+                                files[i].path.string(), ec.message()));
+      }
+    }
+  } catch (...) {
+    cleanup();
+    throw;
+  }
+}
+
+void write_file_atomic(const fs::path& path, const std::string& content) {
+  write_files_atomic({{path, content}});
+}
+
+}  // namespace rigcal::io

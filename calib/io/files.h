@@ -1,0 +1,27 @@
+#pragma once
+// Whole-file reading and all-or-nothing writing. Every output of rigcal goes through
+// write_files_atomic: each file is written to a temporary name beside its destination, flushed,
+// and renamed only when all of them were written, so a failed run leaves no half-written output.
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace rigcal::io {
+
+// Throws rigcal::Error naming the path when the file cannot be read.
+std::string read_text_file(const std::filesystem::path& path);
+
+struct OutputFile {
+  std::filesystem::path path;
+  std::string content;
+};
+// Creates missing parent folders. On failure nothing is renamed and the temporaries are removed.
+void write_files_atomic(const std::vector<OutputFile>& files);
+void write_file_atomic(const std::filesystem::path& path, const std::string& content);
+
+// A temporary path beside `path` (same folder, so a rename is atomic), for writers that need a
+// file name (cv::FileStorage). The caller renames or removes it.
+std::filesystem::path temporary_sibling(const std::filesystem::path& path);
+
+}  // namespace rigcal::io
