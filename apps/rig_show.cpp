@@ -23,9 +23,14 @@ void print_rig(const std::string& file, const rig::Rig& r) {
       "and clock offsets (ms, added to the sensor's stamps):\n");
   fmt::print("  {:<10} {:<7} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>10}\n", "sensor", "type", "x",
              "y", "z", "roll", "pitch", "yaw", "offset");
+  // Values that print as zero print without a sign.
+  auto clean = [](Eigen::Vector3d v, double resolution) {
+    for (double& x : v) x = std::abs(x) < resolution / 2 ? 0.0 : x;
+    return v;
+  };
   for (const rig::Sensor& s : r.sensors) {
-    const Eigen::Vector3d rpy = roll_pitch_yaw(s.T_base_sensor.R) * kDeg;
-    const Eigen::Vector3d& t = s.T_base_sensor.t;
+    const Eigen::Vector3d rpy = clean(roll_pitch_yaw(s.T_base_sensor.R) * kDeg, 1e-3);
+    const Eigen::Vector3d t = clean(s.T_base_sensor.t, 1e-4);
     fmt::print("  {:<10} {:<7} {:>9.4f} {:>9.4f} {:>9.4f} {:>9.3f} {:>9.3f} {:>9.3f} {:>10.3f}\n",
                s.name, rig::to_string(s.type), t.x(), t.y(), t.z(), rpy.x(), rpy.y(), rpy.z(),
                s.time_offset * 1e3);

@@ -101,8 +101,9 @@ class Reader {
   void check_last_row(const YAML::Node& n, const std::string& key, const Eigen::Matrix4d& m) const {
     if (m.row(3) != Eigen::RowVector4d(0, 0, 0, 1)) {
       fail(n, key,
-           fmt::format("the last row of a rigid transform must be [0, 0, 0, 1], got [{}, {}, {}, {}]",
-                       m(3, 0), m(3, 1), m(3, 2), m(3, 3)));
+           fmt::format(
+               "the last row of a rigid transform must be [0, 0, 0, 1], got [{}, {}, {}, {}]",
+               m(3, 0), m(3, 1), m(3, 2), m(3, 3)));
     }
   }
   std::string file_;

@@ -101,7 +101,8 @@ TEST(Time, ParsesIso8601AndPrintsBack) {
   EXPECT_EQ(parse_time("2024-03-20 12:00:00.5").ns, 1710936000500000000LL);
   EXPECT_EQ(to_iso8601(Time{-1}), "1969-12-31T23:59:59.999999999");
   EXPECT_EQ(parse_iso8601(to_iso8601(Time{-1})).ns, -1);
-  for (const char* bad : {"2024-02-30T00:00:00", "2024-03-20T25:00:00", "2024-03-20", "2024-03-20T1:00:00"}) {
+  for (const char* bad :
+       {"2024-02-30T00:00:00", "2024-03-20T25:00:00", "2024-03-20", "2024-03-20T1:00:00"}) {
     EXPECT_THROW(parse_iso8601(bad), Error) << bad;
   }
 }

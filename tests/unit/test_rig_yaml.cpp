@@ -154,9 +154,11 @@ TEST(RigYaml, TCamLidarIsInverseCamTbTimesLidarTb) {
   // The identity holds for a base sensor whose T_b is not the identity too.
   sensor(rig, "lidar").T_base_sensor =
       SE3::from_rotation_vector(Eigen::Vector3d(0.1, -0.2, 0.3), Eigen::Vector3d(1, 2, 3));
-  const SE3 expected = sensor(rig, "cam_l").T_base_sensor.inverse() * sensor(rig, "lidar").T_base_sensor;
+  const SE3 expected =
+      sensor(rig, "cam_l").T_base_sensor.inverse() * sensor(rig, "lidar").T_base_sensor;
   EXPECT_TRUE(T_a_b(rig, "cam_l", "lidar").matrix().isApprox(expected.matrix(), 1e-15));
-  EXPECT_TRUE((T_a_b(rig, "cam_l", "cam_r") * T_a_b(rig, "cam_r", "cam_l")).matrix().isIdentity(1e-15));
+  EXPECT_TRUE(
+      (T_a_b(rig, "cam_l", "cam_r") * T_a_b(rig, "cam_r", "cam_l")).matrix().isIdentity(1e-15));
 }
 
 TEST(RigYaml, KeepsUnknownKeysAndMetadata) {
@@ -203,41 +205,49 @@ std::string camera_with(const std::string& replace_key, const std::string& new_l
 
 TEST(RigYaml, EveryValidationErrorNamesFileLineAndKey) {
   const std::vector<BadCase> cases = {
-      {"matrix with 3 rows", camera_with("T_b", "  T_b: [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0]]"),
+      {"matrix with 3 rows",
+       camera_with("T_b", "  T_b: [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0]]"),
        "rig.yaml:7: key 'cam_l.T_b': expected a 4x4 matrix as a list of 4 rows of 4 numbers; got "
        "3 rows"},
       {"row with 3 entries",
-       camera_with("T_b", "  T_b:\n  - [1, 0, 0, 0]\n  - [0, 1, 0]\n  - [0, 0, 1, 0]\n  - [0, 0, 0, 1]"),
+       camera_with("T_b",
+                   "  T_b:\n  - [1, 0, 0, 0]\n  - [0, 1, 0]\n  - [0, 0, 1, 0]\n  - [0, 0, 0, 1]"),
        "rig.yaml:9: key 'cam_l.T_b': expected a 4x4 matrix as a list of 4 rows of 4 numbers; row 2 "
        "has 3 entries"},
-      {"last row", camera_with("T_b", "  T_b: [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 1, 1]]"),
+      {"last row",
+       camera_with("T_b", "  T_b: [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 1, 1]]"),
        "rig.yaml:7: key 'cam_l.T_b': the last row of a rigid transform must be [0, 0, 0, 1], got "
        "[0, 0, 1, 1]"},
       {"not orthonormal",
        camera_with("T_b", "  T_b: [[1, 0.001, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]"),
        "rig.yaml:7: key 'cam_l.T_b': rotation is not orthonormal: max |R^T R - I| = 0.001 exceeds "
        "the tolerance 1e-05"},
-      {"reflection", camera_with("T_b", "  T_b: [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, -1, 0], [0, 0, 0, 1]]"),
+      {"reflection",
+       camera_with("T_b", "  T_b: [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, -1, 0], [0, 0, 0, 1]]"),
        "rig.yaml:7: key 'cam_l.T_b': rotation has determinant < 0 (a reflection, not a rotation)"},
       {"negative focal length", camera_with("intrinsics", "  intrinsics: [-1000, 1000, 640, 360]"),
        "rig.yaml:4: key 'cam_l.intrinsics': focal lengths fx, fy must be > 0, got fx = -1000, fy = "
        "1000"},
       {"zero focal length", camera_with("intrinsics", "  intrinsics: [1000, 0, 640, 360]"),
-       "rig.yaml:4: key 'cam_l.intrinsics': focal lengths fx, fy must be > 0, got fx = 1000, fy = 0"},
+       "rig.yaml:4: key 'cam_l.intrinsics': focal lengths fx, fy must be > 0, got fx = 1000, fy = "
+       "0"},
       {"intrinsics count", camera_with("intrinsics", "  intrinsics: [1000, 1000, 640]"),
        "rig.yaml:4: key 'cam_l.intrinsics': expected 4 numbers [fx, fy, cx, cy], got 3"},
       {"unknown distortion model", camera_with("distortion_model", "  distortion_model: fisheye"),
        "rig.yaml:3: key 'cam_l.distortion_model': unknown distortion model 'fisheye'; expected "
        "radtan (k1 k2 p1 p2 [k3]) or equidistant (k1 k2 k3 k4)"},
       {"unknown camera model", camera_with("camera_model", "  camera_model: omni"),
-       "rig.yaml:2: key 'cam_l.camera_model': unknown camera model 'omni'; rigcal supports pinhole"},
-      {"radtan coefficient count", camera_with("distortion_coeffs", "  distortion_coeffs: [0.1, 0.01, 0]"),
+       "rig.yaml:2: key 'cam_l.camera_model': unknown camera model 'omni'; rigcal supports "
+       "pinhole"},
+      {"radtan coefficient count",
+       camera_with("distortion_coeffs", "  distortion_coeffs: [0.1, 0.01, 0]"),
        "rig.yaml:5: key 'cam_l.distortion_coeffs': radtan takes 4 (k1 k2 p1 p2) or 5 (k1 k2 p1 p2 "
        "k3) coefficients, got 3"},
       {"equidistant coefficient count",
        "cam_l:\n  distortion_model: equidistant\n  camera_model: pinhole\n"
        "  intrinsics: [1000, 1000, 640, 360]\n  distortion_coeffs: [0.1, 0.01, 0, 0, 0]\n"
-       "  resolution: [1280, 720]\n  T_b: [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]\n"
+       "  resolution: [1280, 720]\n  T_b: [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, "
+       "1]]\n"
        "lidar: {T_b: [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]}\n",
        "rig.yaml:5: key 'cam_l.distortion_coeffs': equidistant takes 4 (k1 k2 k3 k4) coefficients, "
        "got 5"},
@@ -248,16 +258,22 @@ TEST(RigYaml, EveryValidationErrorNamesFileLineAndKey) {
        "rig.yaml:6: key 'cam_l.resolution': expected a finite number, got 'abc'"},
       {"fractional resolution", camera_with("resolution", "  resolution: [1280.5, 720]"),
        "rig.yaml:6: key 'cam_l.resolution': expected [width, height] in whole pixels"},
-      {"duplicate sensor", camera_with("lidar", "lidar: {T_b: [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}\ncam_l: {}"),
+      {"duplicate sensor",
+       camera_with("lidar", "lidar: {T_b: [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}\ncam_l: {}"),
        "rig.yaml:9: key 'cam_l': duplicate sensor 'cam_l' (a sensor name appears twice)"},
       {"syntax error", camera_with("resolution", "  resolution: [1280, 720"),
        "rig.yaml:7: YAML syntax error: end of sequence flow not found"},
-      {"unknown sensor kind", camera_with("lidar", "lidar: {T_b: [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}\nthing: {T_b: [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}"),
+      {"unknown sensor kind",
+       camera_with("lidar",
+                   "lidar: {T_b: [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}\nthing: {T_b: "
+                   "[[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}"),
        "rig.yaml:9: key 'thing': cannot tell what kind of sensor this is; add 'sensor_type: "
        "camera|lidar|imu|gnss'"},
       {"camera key on a lidar",
-       camera_with("lidar", "lidar:\n  sensor_type: lidar\n  T_b: [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]\n"
-                            "  intrinsics: [1, 1, 1, 1]"),
+       camera_with(
+           "lidar",
+           "lidar:\n  sensor_type: lidar\n  T_b: [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]\n"
+           "  intrinsics: [1, 1, 1, 1]"),
        "rig.yaml:11: key 'lidar.intrinsics': 'intrinsics' belongs to cameras, but this sensor is a "
        "lidar"},
   };

@@ -30,7 +30,9 @@ inline Sensor random_camera(std::mt19937_64& rng, const std::string& name, Disto
   s.camera.cy = any_double(rng, 300, 400);
   s.camera.distortion_model = model;
   const size_t n = model == DistortionModel::radtan && rng() % 2 ? 5 : 4;
-  for (size_t k = 0; k < n; ++k) s.camera.distortion_coeffs.push_back(any_double(rng, -0.3, 0.3) * (k < 2 || model == DistortionModel::equidistant ? 1 : 0.01));
+  for (size_t k = 0; k < n; ++k)
+    s.camera.distortion_coeffs.push_back(
+        any_double(rng, -0.3, 0.3) * (k < 2 || model == DistortionModel::equidistant ? 1 : 0.01));
   return s;
 }
 

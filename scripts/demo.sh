@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# `make demo`: the main job on the bundled sample. Today: check the sample rig's calibration YAML,
+# show it, and write it in every export format. Each calibration step extends this script.
+set -euo pipefail
+build=${1:-build}
+root=$(cd "$(dirname "$0")/.." && pwd)
+rigcal="$root/$build/bin/rigcal"
+[[ -x "$rigcal" ]] || rigcal="$build/bin/rigcal"
+sample="$root/data/sample_rig.yaml"
+out="$root/$build/demo"
+rm -rf "$out"
+mkdir -p "$out"
+
+echo "== rigcal demo: the sample rig ($sample)"
+"$rigcal" rig validate "$sample"
+echo
+"$rigcal" rig show "$sample"
+echo
+echo "== exports"
+"$rigcal" rig convert "$sample" --to rigcal --out "$out/calib.yaml"
+"$rigcal" rig convert "$sample" --to vbr    --out "$out/vbr_calib.yaml"
+"$rigcal" rig convert "$sample" --to kalibr --out "$out/camchain-imucam.yaml"
+"$rigcal" rig convert "$sample" --to opencv --out "$out/opencv_stereo.yaml"
+"$rigcal" rig convert "$sample" --to ros    --out "$out/ros"
+"$rigcal" rig convert "$sample" --to mrcal  --out "$out/mrcal"
+echo
+echo "The calibration YAML and its exports are in $out:"
+(cd "$out" && find . -type f | sort | sed 's|^\./|  |')
