@@ -7,7 +7,7 @@
 
 #include "cli.h"
 #include "rigcal/core/error.h"
-#include "rigcal_version.h"
+#include "rigcal/core/version.h"
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -15,8 +15,7 @@ int main(int argc, char** argv) {
       "the calibration as YAML, and scores trajectories. Conventions: T_a_b maps points of frame\n"
       "b into frame a; the base frame is the LiDAR; SI units. See doc/ for every format.",
       "rigcal"};
-  app.set_version_flag("--version",
-                       fmt::format("rigcal {} ({})", RIGCAL_VERSION, RIGCAL_GIT_REVISION));
+  app.set_version_flag("--version", rigcal::version_string());
   app.require_subcommand(1);
   app.footer("Exit status: 0 success, 2 bad input (the message names file, line and key), 1 bug.");
 

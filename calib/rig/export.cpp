@@ -9,8 +9,8 @@
 
 #include "rigcal/core/error.h"
 #include "rigcal/core/text.h"
+#include "rigcal/core/version.h"
 #include "rigcal/rig/rig_yaml.h"
-#include "rigcal_version.h"
 
 extern "C" {
 #include <mrcal/mrcal.h>
@@ -18,21 +18,6 @@ extern "C" {
 
 namespace rigcal::rig {
 namespace {
-
-std::string list(const std::vector<double>& v) {
-  std::vector<std::string> parts;
-  for (double x : v) parts.push_back(yaml_number(x));
-  return fmt::format("[{}]", fmt::join(parts, ", "));
-}
-
-std::string matrix4_rows(const SE3& T, std::string_view indent) {
-  const Eigen::Matrix4d m = T.matrix();
-  std::string out;
-  for (int r = 0; r < 4; ++r) {
-    out += fmt::format("{}- {}\n", indent, list({m(r, 0), m(r, 1), m(r, 2), m(r, 3)}));
-  }
-  return out;
-}
 
 std::vector<double> row_major(const cv::Mat& m) {
   cv::Mat d;
@@ -46,10 +31,6 @@ const Sensor& camera(const Rig& rig, std::string_view name) {
     throw Error(fmt::format("sensor '{}' is a {}, not a camera", name, to_string(s.type)));
   }
   return s;
-}
-
-std::string generated_by() {
-  return fmt::format("rigcal {} ({})", RIGCAL_VERSION, RIGCAL_GIT_REVISION);
 }
 
 struct StereoPair {
@@ -153,7 +134,7 @@ std::string kalibr_camchain_yaml(const Rig& rig, const ExportOptions& options) {
   std::string out = fmt::format(
       "# Kalibr camchain written by {}. T_cn_cnm1 maps cam(n-1) points into cam(n);\n"
       "# T_cam_imu maps {} points into the camera; t_imu = t_cam + timeshift_cam_imu.\n",
-      generated_by(), imu.empty() ? "IMU" : imu);
+      version_string(), imu.empty() ? "IMU" : imu);
   for (size_t i = 0; i < cams.size(); ++i) {
     const Sensor& s = *cams[i];
     const CameraModel& c = s.camera;
@@ -169,10 +150,10 @@ std::string kalibr_camchain_yaml(const Rig& rig, const ExportOptions& options) {
     }
     out += fmt::format("cam{}:\n", i);
     if (i > 0) {
-      out += "  T_cn_cnm1:\n" + matrix4_rows(T_a_b(rig, s.name, cams[i - 1]->name), "    ");
+      out += "  T_cn_cnm1:\n" + yaml_matrix4_rows(T_a_b(rig, s.name, cams[i - 1]->name), "    ");
     }
     if (!imu.empty()) {
-      out += "  T_cam_imu:\n" + matrix4_rows(T_a_b(rig, s.name, imu), "    ");
+      out += "  T_cam_imu:\n" + yaml_matrix4_rows(T_a_b(rig, s.name, imu), "    ");
     }
     std::vector<std::string> overlaps;
     for (size_t j = 0; j < cams.size(); ++j) {
@@ -180,9 +161,9 @@ std::string kalibr_camchain_yaml(const Rig& rig, const ExportOptions& options) {
     }
     out += fmt::format("  cam_overlaps: [{}]\n", fmt::join(overlaps, ", "));
     out += "  camera_model: pinhole\n";
-    out += fmt::format("  distortion_coeffs: {}\n", list(coeffs));
+    out += fmt::format("  distortion_coeffs: {}\n", yaml_list(coeffs));
     out += fmt::format("  distortion_model: {}\n", to_string(c.distortion_model));
-    out += fmt::format("  intrinsics: {}\n", list({c.fx, c.fy, c.cx, c.cy}));
+    out += fmt::format("  intrinsics: {}\n", yaml_list({c.fx, c.fy, c.cx, c.cy}));
     out += fmt::format("  resolution: [{}, {}]\n", c.width, c.height);
     out += fmt::format("  rostopic: /{}/image_raw\n", s.name);
     if (!imu.empty()) {
@@ -200,7 +181,7 @@ std::string opencv_yaml(const Rig& rig) {
   cv::FileStorage fs(
       ".yaml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
   fs.writeComment(fmt::format(
-      " Written by {}. Camera 1 = {}{}. R, T: p2 = R * p1 + T (metres).", generated_by(),
+      " Written by {}. Camera 1 = {}{}. R, T: p2 = R * p1 + T (metres).", version_string(),
       cams[0]->name, cams.size() > 1 ? fmt::format(", camera 2 = {}", cams[1]->name) : ""));
   for (size_t i = 0; i < std::min<size_t>(cams.size(), 2); ++i) {
     const CameraModel& c = cams[i]->camera;
@@ -247,9 +228,10 @@ std::string ros_camera_info_yaml(const Rig& rig, std::string_view name) {
     d.resize(5, 0.0);  // plumb_bob is k1 k2 p1 p2 k3
   }
   auto block = [](std::string_view key, int rows, int cols, const std::vector<double>& data) {
-    return fmt::format("{}:\n  rows: {}\n  cols: {}\n  data: {}\n", key, rows, cols, list(data));
+    return fmt::format("{}:\n  rows: {}\n  cols: {}\n  data: {}\n", key, rows, cols,
+                       yaml_list(data));
   };
-  std::string out = fmt::format("# ROS camera_info written by {} ({}).\n", generated_by(), how);
+  std::string out = fmt::format("# ROS camera_info written by {} ({}).\n", version_string(), how);
   out += fmt::format("image_width: {}\nimage_height: {}\ncamera_name: {}\n", c.width, c.height,
                      s.name);
   out += block("camera_matrix", 3, 3, {c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1});
@@ -287,8 +269,8 @@ std::string mrcal_cameramodel(const Rig& rig, std::string_view name) {
       "    'imagersize': [{}, {}],\n"
       "    'extrinsics': {},\n"
       "}}\n",
-      s.name, generated_by(), rig.base_frame, lensmodel, list(intrinsics), c.width, c.height,
-      list(rt));
+      s.name, version_string(), rig.base_frame, lensmodel, yaml_list(intrinsics), c.width, c.height,
+      yaml_list(rt));
 
   // Self-check with libmrcal's own reader: the file must load, with our lens model.
   mrcal_cameramodel_t* model =

@@ -9,9 +9,9 @@
 
 #include "rigcal/core/error.h"
 #include "rigcal/core/text.h"
+#include "rigcal/core/version.h"
 #include "rigcal/io/files.h"
 #include "rigcal/rig/checks.h"
-#include "rigcal_version.h"
 
 namespace rigcal::rig {
 namespace {
@@ -287,21 +287,6 @@ std::string yaml_string(const std::string& s) {
   return out + "\"";
 }
 
-std::string yaml_list(const std::vector<double>& v) {
-  std::vector<std::string> parts;
-  for (double x : v) parts.push_back(yaml_number(x));
-  return fmt::format("[{}]", fmt::join(parts, ", "));
-}
-
-std::string yaml_matrix4(const SE3& T) {
-  const Eigen::Matrix4d m = T.matrix();
-  std::string out;
-  for (int r = 0; r < 4; ++r) {
-    out += fmt::format("    - {}\n", yaml_list({m(r, 0), m(r, 1), m(r, 2), m(r, 3)}));
-  }
-  return out;
-}
-
 constexpr const char* kHeader =
     "# Calibration of a sensor rig, written by rigcal (format: doc/calibration-yaml.md).\n"
     "# T_b: the sensor's pose in the base frame (p_base = T_b * p_sensor), 4x4, rows; metres.\n"
@@ -324,7 +309,7 @@ std::string sensors_yaml(const Rig& rig, bool full) {
       out += fmt::format("  distortion_coeffs: {}\n", yaml_list(c.distortion_coeffs));
       out += fmt::format("  resolution: [{}, {}]\n", c.width, c.height);
     }
-    out += "  T_b:\n" + yaml_matrix4(s.T_base_sensor);
+    out += "  T_b:\n" + yaml_matrix4_rows(s.T_base_sensor, "    ");
     if (full) out += fmt::format("  time_offset: {}\n", yaml_number(s.time_offset));
     if (s.type == SensorType::imu) {
       const std::optional<double>* fields[] = {
@@ -352,6 +337,21 @@ std::string sensors_yaml(const Rig& rig, bool full) {
 }  // namespace
 
 std::string yaml_number(double value) { return format_double(value, /*keep_point=*/true); }
+
+std::string yaml_list(const std::vector<double>& values) {
+  std::vector<std::string> parts;
+  for (double x : values) parts.push_back(yaml_number(x));
+  return fmt::format("[{}]", fmt::join(parts, ", "));
+}
+
+std::string yaml_matrix4_rows(const SE3& T, std::string_view indent) {
+  const Eigen::Matrix4d m = T.matrix();
+  std::string out;
+  for (int r = 0; r < 4; ++r) {
+    out += fmt::format("{}- {}\n", indent, yaml_list({m(r, 0), m(r, 1), m(r, 2), m(r, 3)}));
+  }
+  return out;
+}
 
 Rig parse_rig_yaml(std::string_view text, std::string_view file_name) {
   Reader r(file_name);
@@ -417,9 +417,7 @@ std::string rig_to_yaml(const Rig& rig) {
   out += "rigcal:\n";
   out += fmt::format("  format_version: {}\n", kFormatVersion);
   out += fmt::format("  base_frame: {}\n", yaml_string(rig.base_frame));
-  out +=
-      fmt::format("  written_by: {}\n",
-                  yaml_string(fmt::format("rigcal {} ({})", RIGCAL_VERSION, RIGCAL_GIT_REVISION)));
+  out += fmt::format("  written_by: {}\n", yaml_string(version_string()));
   if (!rig.notes.empty()) {
     out += "  notes:\n";
     for (const std::string& n : rig.notes) out += fmt::format("    - {}\n", yaml_string(n));

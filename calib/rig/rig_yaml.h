@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "rigcal/rig/rig.h"
 
@@ -27,5 +28,9 @@ std::string rig_to_vbr_yaml(const Rig& rig);
 
 // Shortest YAML text of a double that reads back bit-identical, with a '.' as YAML 1.1 wants.
 std::string yaml_number(double value);
+// "[a, b, c]" of yaml_number()s.
+std::string yaml_list(const std::vector<double>& values);
+// The 4 rows of T's matrix as a block list of flow rows, each line starting with `indent`.
+std::string yaml_matrix4_rows(const SE3& T, std::string_view indent);
 
 }  // namespace rigcal::rig
