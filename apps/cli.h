@@ -9,5 +9,7 @@ namespace rigcal::cli {
 void add_rig_validate(CLI::App& rig);
 void add_rig_show(CLI::App& rig);
 void add_rig_convert(CLI::App& rig);
+// `rigcal bench`
+void add_bench(CLI::App& app);
 
 }  // namespace rigcal::cli

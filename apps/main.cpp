@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   rigcal::cli::add_rig_validate(*rig);
   rigcal::cli::add_rig_show(*rig);
   rigcal::cli::add_rig_convert(*rig);
+  rigcal::cli::add_bench(app);
 
   try {
     app.parse(argc, argv);

@@ -5,6 +5,7 @@ include(CMakeFindDependencyMacro)
 find_dependency(Eigen3 3.4 NO_MODULE)
 find_dependency(yaml-cpp)
 find_dependency(fmt)
+find_dependency(nlohmann_json 3)
 find_dependency(OpenCV 4 COMPONENTS core calib3d)
 
 # mrcal 2.2 ships no CMake or pkg-config file: one header folder and -lmrcal.

@@ -1,0 +1,379 @@
+#include "rigcal/bench/evaluate.h"
+
+#include <fmt/format.h>
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+#include <cmath>
+
+#include "rigcal/core/error.h"
+
+namespace rigcal::bench {
+namespace {
+
+constexpr double kDeg = 180.0 / M_PI;
+
+Association default_association(Convention c, const Trajectory& gt, const Trajectory& est) {
+  if (!gt.has_stamps || !est.has_stamps) return Association::index;
+  switch (c) {
+    case Convention::rigcal:
+      return Association::interpolate;
+    case Convention::kitti:
+      return Association::one_to_one;
+    case Convention::evo:
+    case Convention::vbr:
+      return Association::nearest;
+  }
+  return Association::nearest;
+}
+
+Alignment default_alignment(Convention c) {
+  return c == Convention::rigcal || c == Convention::vbr ? Alignment::se3 : Alignment::none;
+}
+
+// The KITTI devkit's segment errors, in double: general 4x4 inverses (the devkit inverts
+// matrices, it does not transpose them) and the rotation angle as acos((trace - 1) / 2).
+std::vector<Segment> kitti_devkit_segments(const std::vector<SE3>& gt,
+                                           const std::vector<SE3>& est) {
+  std::vector<Segment> out;
+  const std::vector<double> dist = cumulative_distances(gt);
+  for (size_t first = 0; first < gt.size(); first += 10) {
+    for (double len : kKittiLengths) {
+      const auto it = std::upper_bound(dist.begin() + first, dist.end(), dist[first] + len);
+      if (it == dist.end()) continue;
+      const size_t last = it - dist.begin();
+      const Eigen::Matrix4d d_gt = gt[first].matrix().inverse() * gt[last].matrix();
+      const Eigen::Matrix4d d_est = est[first].matrix().inverse() * est[last].matrix();
+      const Eigen::Matrix4d E = d_est.inverse() * d_gt;
+      const double d = 0.5 * (E(0, 0) + E(1, 1) + E(2, 2) - 1.0);
+      const double r = std::acos(std::max(std::min(d, 1.0), -1.0));
+      out.push_back({first, last, len, E.topRightCorner<3, 1>().norm(), r * kDeg});
+    }
+  }
+  return out;
+}
+
+RpeResult make_rpe(std::string kind, std::string definition, std::vector<Segment> segments,
+                   bool keep) {
+  RpeResult r;
+  r.kind = std::move(kind);
+  r.definition = std::move(definition);
+  r.drift = pooled_drift(segments);
+  std::vector<double> t, a;
+  for (const Segment& s : segments) {
+    t.push_back(s.trans);
+    a.push_back(s.rot_deg);
+  }
+  r.trans = statistics(t);
+  r.rot_deg = statistics(a);
+  if (keep) r.segments = std::move(segments);
+  return r;
+}
+
+// ---- The VBR evaluator, reproduced in float (vbr_benchmark.cpp)
+// ----------------------------------
+struct VbrFigures {
+  double rpe_trans_pct = 0, rpe_rot_deg_per_m = 0, ate_trans = 0, ate_rot = 0;
+  size_t n_segments = 0;
+  std::vector<size_t> matched;  // estimate index per GT pose
+};
+
+Eigen::Isometry3f to_float(const SE3& T) {
+  Eigen::Isometry3f out = Eigen::Isometry3f::Identity();
+  out.linear() = T.R.cast<float>();
+  out.translation() = T.t.cast<float>();
+  return out;
+}
+
+float vbr_rotation_error_deg(const Eigen::Isometry3f& E) {
+  Eigen::Quaternionf q(E.linear());
+  q.normalize();
+  const float rad = Eigen::Quaternionf(1.0f, 0.0f, 0.0f, 0.0f).angularDistance(q);
+  return rad * (180.0f / M_PI);
+}
+
+VbrFigures vbr_evaluator(const Trajectory& gt, const Trajectory& est) {
+  VbrFigures f;
+  std::vector<float> t_gt(gt.size()), t_est(est.size());
+  for (size_t i = 0; i < gt.size(); ++i) t_gt[i] = static_cast<float>(gt.stamps[i].seconds());
+  for (size_t i = 0; i < est.size(); ++i) t_est[i] = static_cast<float>(est.stamps[i].seconds());
+  // Nearest estimate stamp per GT pose, walking forward, no threshold.
+  size_t k = 0;
+  for (size_t i = 0; i < gt.size(); ++i) {
+    float min_delta = std::abs(t_est[k] - t_gt[i]);
+    while (k + 1 < est.size() && std::abs(t_est[k + 1] - t_gt[i]) <= min_delta) {
+      min_delta = std::abs(t_est[k + 1] - t_gt[i]);
+      ++k;
+    }
+    f.matched.push_back(k);
+  }
+  std::vector<Eigen::Isometry3f> P_gt(gt.size()), P_es(gt.size());
+  for (size_t i = 0; i < gt.size(); ++i) {
+    P_gt[i] = to_float(gt.T_world_body[i]);
+    P_es[i] = to_float(est.T_world_body[f.matched[i]]);
+  }
+  // RPE over fractions of the GT length, every frame a start, float sums.
+  std::vector<float> dist(gt.size(), 0.0f);
+  for (size_t i = 1; i < gt.size(); ++i) {
+    dist[i] = dist[i - 1] + (P_gt[i - 1].translation() - P_gt[i].translation()).norm();
+  }
+  std::vector<float> lengths;
+  for (double p : kVbrFractions) lengths.push_back(dist.back() * static_cast<float>(p));
+  float t_sum = 0.0f, r_sum = 0.0f;
+  size_t n = 0;
+  for (size_t first = 0; first < gt.size(); ++first) {
+    for (float len : lengths) {
+      const auto it = std::upper_bound(dist.begin() + first, dist.end(), dist[first] + len);
+      if (it == dist.end()) continue;
+      const size_t last = it - dist.begin();
+      const Eigen::Isometry3f d_gt = P_gt[first].inverse() * P_gt[last];
+      const Eigen::Isometry3f d_es = P_es[first].inverse() * P_es[last];
+      const Eigen::Isometry3f E = d_es.inverse() * d_gt;
+      r_sum += vbr_rotation_error_deg(E) / len;
+      t_sum += E.translation().norm() / len;
+      ++n;
+    }
+  }
+  f.n_segments = n;
+  f.rpe_rot_deg_per_m = r_sum / static_cast<float>(n);
+  f.rpe_trans_pct = 100 * t_sum / static_cast<float>(n);
+  // ATE: float Umeyama SE(3) of the matched estimate onto the GT, then sqrt(mean |e|).
+  Eigen::Matrix<float, 3, Eigen::Dynamic> X(3, gt.size()), Y(3, gt.size());
+  for (size_t i = 0; i < gt.size(); ++i) {
+    X.col(i) = P_es[i].translation();
+    Y.col(i) = P_gt[i].translation();
+  }
+  const Eigen::Matrix4f A = Eigen::umeyama(X, Y, false);
+  Eigen::Isometry3f T_align(A.block<3, 3>(0, 0));
+  T_align.translation() = A.block<3, 1>(0, 3);
+  float at = 0.0f, ar = 0.0f;
+  for (size_t i = 0; i < gt.size(); ++i) {
+    const Eigen::Isometry3f E = P_gt[i].inverse() * (T_align * P_es[i]);
+    ar += vbr_rotation_error_deg(E);
+    at += E.translation().norm();
+  }
+  f.ate_trans = std::sqrt(at / static_cast<float>(gt.size()));
+  f.ate_rot = std::sqrt(ar / static_cast<float>(gt.size()));
+  return f;
+}
+
+}  // namespace
+
+Convention convention_from_string(std::string_view name) {
+  for (Convention c : {Convention::rigcal, Convention::evo, Convention::kitti, Convention::vbr}) {
+    if (name == to_string(c)) return c;
+  }
+  throw Error(fmt::format("unknown convention '{}'; expected rigcal, evo, kitti or vbr", name));
+}
+
+std::string_view to_string(Convention convention) {
+  switch (convention) {
+    case Convention::rigcal:
+      return "rigcal";
+    case Convention::evo:
+      return "evo";
+    case Convention::kitti:
+      return "kitti";
+    case Convention::vbr:
+      return "vbr";
+  }
+  return "?";
+}
+
+Association association_from_string(std::string_view name) {
+  for (Association a : {Association::interpolate, Association::nearest, Association::one_to_one,
+                        Association::index}) {
+    if (name == to_string(a)) return a;
+  }
+  throw Error(fmt::format(
+      "unknown association '{}'; expected interpolate, nearest, one_to_one or index", name));
+}
+
+std::string_view to_string(Association association) {
+  switch (association) {
+    case Association::interpolate:
+      return "interpolate";
+    case Association::nearest:
+      return "nearest";
+    case Association::one_to_one:
+      return "one_to_one";
+    case Association::index:
+      return "index";
+  }
+  return "?";
+}
+
+const RpeResult* find_rpe(const EvalResult& result, std::string_view kind) {
+  for (const RpeResult& r : result.rpe) {
+    if (r.kind == kind) return &r;
+  }
+  return nullptr;
+}
+
+EvalResult evaluate(const Trajectory& gt_in, const Trajectory& est_in, const EvalOptions& opt) {
+  if (gt_in.empty()) throw Error("the ground truth has no poses");
+  if (est_in.empty()) throw Error("the estimate has no poses");
+  EvalResult res;
+  res.convention = opt.convention;
+  res.n_gt = gt_in.size();
+  res.n_est = est_in.size();
+  res.association = opt.association.value_or(default_association(opt.convention, gt_in, est_in));
+  const Alignment alignment = opt.alignment.value_or(default_alignment(opt.convention));
+
+  // rigcal re-orthonormalises rotations read with few digits; the peers use them as read.
+  Trajectory gt = gt_in, est = est_in;
+  if (opt.convention == Convention::rigcal) {
+    for (SE3& T : gt.T_world_body) T.R = nearest_rotation(T.R);
+    for (SE3& T : est.T_world_body) T.R = nearest_rotation(T.R);
+  }
+  if (res.association != Association::index && (!gt.has_stamps || !est.has_stamps)) {
+    throw Error(
+        fmt::format("association '{}' needs stamps on both trajectories; KITTI files "
+                    "without a times file pair by index",
+                    to_string(res.association)));
+  }
+
+  // Matched pose lists.
+  std::vector<SE3> m_gt, m_est;
+  std::vector<Time> m_stamps;
+  if (res.association == Association::interpolate) {
+    const Interpolated in = interpolate_gt(gt, est, opt.max_gap);
+    m_gt = in.T_world_gt;
+    for (size_t i : in.est) {
+      m_est.push_back(est.T_world_body[i]);
+      m_stamps.push_back(est.stamps[i]);
+    }
+    res.notes.push_back(fmt::format(
+        "ground truth interpolated (slerp + linear) at the estimate's stamps inside GT intervals "
+        "up to {} s",
+        opt.max_gap.seconds()));
+  } else if (opt.convention == Convention::vbr && res.association == Association::nearest) {
+    // Filled below from the evaluator's own walk.
+  } else {
+    Matches m;
+    if (res.association == Association::index) {
+      if (gt.size() != est.size()) {
+        throw Error(
+            fmt::format("pairing by index needs as many poses in both: {} in the ground "
+                        "truth, {} in the estimate (give stamps, or a KITTI times file)",
+                        gt.size(), est.size()));
+      }
+      m = associate_by_index(gt, est);
+    } else if (res.association == Association::nearest) {
+      m = associate_evo(gt, est, opt.max_diff);
+      res.notes.push_back(fmt::format(
+          "each stamp of the shorter trajectory takes the nearest of the longer within {} s "
+          "(evo's rule, not one-to-one)",
+          opt.max_diff.seconds()));
+    } else {
+      m = associate_one_to_one(gt, est, opt.max_diff);
+      res.notes.push_back(
+          fmt::format("one-to-one pairs within {} s, closest first", opt.max_diff.seconds()));
+    }
+    for (size_t k = 0; k < m.gt.size(); ++k) {
+      m_gt.push_back(gt.T_world_body[m.gt[k]]);
+      m_est.push_back(est.T_world_body[m.est[k]]);
+      m_stamps.push_back(gt.stamps[m.gt[k]]);
+    }
+  }
+
+  std::optional<VbrFigures> vbr;
+  if (opt.convention == Convention::vbr) {
+    if (!gt.has_stamps || !est.has_stamps)
+      throw Error("the vbr convention needs stamped trajectories");
+    vbr = vbr_evaluator(gt, est);
+    if (res.association == Association::nearest) {
+      for (size_t i = 0; i < gt.size(); ++i) {
+        m_gt.push_back(gt.T_world_body[i]);
+        m_est.push_back(est.T_world_body[vbr->matched[i]]);
+        m_stamps.push_back(gt.stamps[i]);
+      }
+      res.notes.push_back(
+          "VBR evaluator: every GT pose takes the nearest estimate stamp, with no threshold; "
+          "stamps compared in float");
+    }
+  }
+
+  res.n_pairs = m_gt.size();
+  if (res.n_pairs == 0) {
+    throw Error(
+        fmt::format("no pose pairs: the trajectories do not overlap in time (GT {}..{} s, "
+                    "estimate {}..{} s, association {})",
+                    to_seconds_text(gt.stamps.front()), to_seconds_text(gt.stamps.back()),
+                    to_seconds_text(est.stamps.front()), to_seconds_text(est.stamps.back()),
+                    to_string(res.association)));
+  }
+
+  res.alignment = align(m_gt, m_est, alignment, opt.align_first_n);
+  std::vector<SE3> m_est_aligned(m_est.size());
+  for (size_t i = 0; i < m_est.size(); ++i) m_est_aligned[i] = apply(res.alignment, m_est[i]);
+
+  const PoseErrors ate = absolute_errors(m_gt, m_est_aligned);
+  res.ate_trans = statistics(ate.trans);
+  res.ate_rot_deg = statistics(ate.rot_deg);
+  res.gt_length = cumulative_distances(m_gt).back();
+  res.stamps = m_stamps;
+  res.ate_trans_errors = ate.trans;
+  for (size_t i = 0; i < m_gt.size(); ++i) {
+    res.p_gt.push_back(m_gt[i].t);
+    res.p_est_aligned.push_back(m_est_aligned[i].t);
+  }
+
+  const bool keep = opt.keep_segments;
+  switch (opt.convention) {
+    case Convention::rigcal: {
+      std::vector<double> lengths;
+      for (double f : kVbrFractions) lengths.push_back(f * res.gt_length);
+      res.rpe.push_back(
+          make_rpe("kitti", "KITTI: segments of 100..800 m of GT path, a start every 10 frames",
+                   length_segments(m_gt, m_est_aligned,
+                                   {std::begin(kKittiLengths), std::end(kKittiLengths)}, 10),
+                   keep));
+      res.rpe.push_back(make_rpe(
+          "vbr",
+          "VBR: segments of 1, 2, 3, 5, 8, 13, 21, 34, 55 % of the GT length, every frame a start",
+          length_segments(m_gt, m_est_aligned, lengths, 1), keep));
+      res.rpe.push_back(
+          make_rpe("delta", fmt::format("consecutive pairs {} frame(s) apart", opt.delta_frames),
+                   frame_deltas(m_gt, m_est_aligned, opt.delta_frames), keep));
+      res.notes.push_back(
+          "rigcal: rotations re-orthonormalised; ATE is the true RMSE; RPE pooled over segments");
+      break;
+    }
+    case Convention::evo:
+      res.rpe.push_back(
+          make_rpe("delta",
+                   fmt::format("evo_rpe: consecutive pairs {} frame(s) apart, E = inv(dQ) dP",
+                               opt.delta_frames),
+                   frame_deltas(m_gt, m_est_aligned, opt.delta_frames), keep));
+      res.notes.push_back(
+          "evo: APE and RPE as evo_ape / evo_rpe compute them; rotation angles from the log map");
+      break;
+    case Convention::kitti:
+      res.rpe.push_back(make_rpe(
+          "kitti",
+          "KITTI devkit: 100..800 m every 10 frames, general inverses, acos angles, in double",
+          kitti_devkit_segments(m_gt, m_est_aligned), keep));
+      res.notes.push_back("kitti: the devkit's metric in double (the devkit itself sums in float)");
+      break;
+    case Convention::vbr: {
+      RpeResult r;
+      r.kind = "vbr";
+      r.definition = "VBR evaluator: 1..55 % of the GT length, every frame a start, in float";
+      r.drift.n_segments = vbr->n_segments;
+      r.drift.trans_pct = vbr->rpe_trans_pct;
+      r.drift.rot_deg_per_m = vbr->rpe_rot_deg_per_m;
+      res.rpe.push_back(r);
+      res.vbr_ate_trans = vbr->ate_trans;
+      res.vbr_ate_rot = vbr->ate_rot;
+      res.notes.push_back(fmt::format(
+          "vbr: the evaluator's \"ATE RMSE\" is sqrt(mean |e|) = {:.6g} m, not an RMSE; the true "
+          "RMSE after the same alignment is {:.6g} m",
+          vbr->ate_trans, res.ate_trans.rmse));
+      break;
+    }
+  }
+  return res;
+}
+
+}  // namespace rigcal::bench

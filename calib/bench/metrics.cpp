@@ -1,0 +1,305 @@
+#include "rigcal/bench/metrics.h"
+
+#include <fmt/format.h>
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "rigcal/core/error.h"
+
+namespace rigcal::bench {
+
+Stats statistics(const std::vector<double>& values) {
+  Stats s;
+  s.n = values.size();
+  if (values.empty()) return s;
+  double sum = 0.0;
+  s.min = values.front();
+  s.max = values.front();
+  for (double v : values) {
+    sum += v;
+    s.sse += v * v;
+    s.min = std::min(s.min, v);
+    s.max = std::max(s.max, v);
+  }
+  const double n = static_cast<double>(values.size());
+  s.mean = sum / n;
+  s.rmse = std::sqrt(s.sse / n);
+  double var = 0.0;
+  for (double v : values) var += (v - s.mean) * (v - s.mean);
+  s.std = std::sqrt(var / n);
+  std::vector<double> sorted = values;
+  const size_t mid = sorted.size() / 2;
+  std::nth_element(sorted.begin(), sorted.begin() + mid, sorted.end());
+  if (sorted.size() % 2 == 1) {
+    s.median = sorted[mid];
+  } else {
+    const double upper = sorted[mid];
+    const double lower = *std::max_element(sorted.begin(), sorted.begin() + mid);
+    s.median = 0.5 * (lower + upper);
+  }
+  return s;
+}
+
+std::vector<std::pair<size_t, size_t>> nearest_stamps(const std::vector<Time>& a,
+                                                      const std::vector<Time>& b, Time max_diff) {
+  std::vector<std::pair<size_t, size_t>> pairs;
+  pairs.reserve(std::min(a.size(), b.size()));
+  if (b.empty()) return pairs;
+  size_t j = 0;  // first stamp of b that is >= the current stamp of a (both sorted)
+  for (size_t i = 0; i < a.size(); ++i) {
+    while (j < b.size() && b[j] < a[i]) ++j;
+    size_t best = j;
+    if (j == b.size() || (j > 0 && (a[i] - b[j - 1]) <= (b[j] - a[i]))) best = j - 1;
+    const Time diff = a[i] < b[best] ? b[best] - a[i] : a[i] - b[best];
+    if (diff <= max_diff) pairs.emplace_back(i, best);
+  }
+  return pairs;
+}
+
+Matches associate_evo(const Trajectory& gt, const Trajectory& est, Time max_diff) {
+  Matches m;
+  const bool est_longer = est.size() > gt.size();
+  const auto pairs = est_longer ? nearest_stamps(gt.stamps, est.stamps, max_diff)
+                                : nearest_stamps(est.stamps, gt.stamps, max_diff);
+  for (const auto& [short_i, long_i] : pairs) {
+    m.gt.push_back(est_longer ? short_i : long_i);
+    m.est.push_back(est_longer ? long_i : short_i);
+  }
+  return m;
+}
+
+Matches associate_one_to_one(const Trajectory& gt, const Trajectory& est, Time max_diff) {
+  struct Candidate {
+    int64_t diff;
+    size_t gt, est;
+  };
+  std::vector<Candidate> candidates;
+  size_t lo = 0;
+  for (size_t i = 0; i < gt.size(); ++i) {
+    while (lo < est.size() && est.stamps[lo] < gt.stamps[i] - max_diff) ++lo;
+    for (size_t j = lo; j < est.size() && est.stamps[j] <= gt.stamps[i] + max_diff; ++j) {
+      candidates.push_back({std::abs((gt.stamps[i] - est.stamps[j]).ns), i, j});
+    }
+  }
+  std::sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) {
+    return std::tie(x.diff, x.gt, x.est) < std::tie(y.diff, y.gt, y.est);
+  });
+  std::vector<char> gt_used(gt.size(), 0), est_used(est.size(), 0);
+  std::vector<std::pair<size_t, size_t>> chosen;
+  for (const Candidate& c : candidates) {
+    if (gt_used[c.gt] || est_used[c.est]) continue;
+    gt_used[c.gt] = est_used[c.est] = 1;
+    chosen.emplace_back(c.gt, c.est);
+  }
+  std::sort(chosen.begin(), chosen.end());
+  Matches m;
+  for (const auto& [g, e] : chosen) {
+    m.gt.push_back(g);
+    m.est.push_back(e);
+  }
+  return m;
+}
+
+Matches associate_by_index(const Trajectory& gt, const Trajectory& est) {
+  Matches m;
+  const size_t n = std::min(gt.size(), est.size());
+  m.gt.resize(n);
+  m.est.resize(n);
+  std::iota(m.gt.begin(), m.gt.end(), 0);
+  std::iota(m.est.begin(), m.est.end(), 0);
+  return m;
+}
+
+SE3 interpolate(const SE3& T_a, const SE3& T_b, double fraction) {
+  const Eigen::Quaterniond q = T_a.quaternion().slerp(fraction, T_b.quaternion());
+  return SE3::from_quaternion(q, (1.0 - fraction) * T_a.t + fraction * T_b.t);
+}
+
+Interpolated interpolate_gt(const Trajectory& gt, const Trajectory& est, Time max_gap) {
+  Interpolated out;
+  size_t j = 0;  // first GT stamp >= the estimate stamp
+  for (size_t i = 0; i < est.size(); ++i) {
+    const Time t = est.stamps[i];
+    while (j < gt.size() && gt.stamps[j] < t) ++j;
+    if (j == gt.size()) break;
+    if (gt.stamps[j] == t) {
+      out.est.push_back(i);
+      out.T_world_gt.push_back(gt.T_world_body[j]);
+      continue;
+    }
+    if (j == 0) continue;
+    const Time gap = gt.stamps[j] - gt.stamps[j - 1];
+    if (gap > max_gap) continue;
+    const double fraction =
+        static_cast<double>((t - gt.stamps[j - 1]).ns) / static_cast<double>(gap.ns);
+    out.est.push_back(i);
+    out.T_world_gt.push_back(interpolate(gt.T_world_body[j - 1], gt.T_world_body[j], fraction));
+  }
+  return out;
+}
+
+Alignment alignment_from_string(std::string_view name) {
+  for (Alignment a :
+       {Alignment::se3, Alignment::sim3, Alignment::yaw, Alignment::origin, Alignment::none}) {
+    if (name == to_string(a)) return a;
+  }
+  throw Error(fmt::format("unknown alignment '{}'; expected se3, sim3, yaw, origin or none", name));
+}
+
+std::string_view to_string(Alignment alignment) {
+  switch (alignment) {
+    case Alignment::se3:
+      return "se3";
+    case Alignment::sim3:
+      return "sim3";
+    case Alignment::yaw:
+      return "yaw";
+    case Alignment::origin:
+      return "origin";
+    case Alignment::none:
+      return "none";
+  }
+  return "?";
+}
+
+AlignmentResult align(const std::vector<SE3>& T_world_gt, const std::vector<SE3>& T_world_est,
+                      Alignment method, size_t n_first) {
+  if (T_world_gt.size() != T_world_est.size()) throw Error("alignment needs matched poses");
+  AlignmentResult r;
+  r.method = method;
+  const size_t n = n_first == 0 ? T_world_gt.size() : std::min(n_first, T_world_gt.size());
+  r.n_used = n;
+  if (method == Alignment::none) return r;
+  if (n == 0) throw Error("no matched poses to align");
+  if (method == Alignment::origin) {
+    r.T_gt_est = T_world_gt.front() * T_world_est.front().inverse();
+    r.n_used = 1;
+    return r;
+  }
+  if (n < 3)
+    throw Error(
+        fmt::format("{} alignment needs at least 3 matched poses, got {}", to_string(method), n));
+  Eigen::Vector3d mean_gt = Eigen::Vector3d::Zero(), mean_est = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < n; ++i) {
+    mean_gt += T_world_gt[i].t;
+    mean_est += T_world_est[i].t;
+  }
+  mean_gt /= static_cast<double>(n);
+  mean_est /= static_cast<double>(n);
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  double var_est = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d g = T_world_gt[i].t - mean_gt, e = T_world_est[i].t - mean_est;
+    cov += g * e.transpose();
+    var_est += e.squaredNorm();
+  }
+  cov /= static_cast<double>(n);
+  var_est /= static_cast<double>(n);
+  if (method == Alignment::yaw) {
+    const double yaw = std::atan2(cov(1, 0) - cov(0, 1), cov(0, 0) + cov(1, 1));
+    r.T_gt_est.R = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    r.T_gt_est.t = mean_gt - r.T_gt_est.R * mean_est;
+    return r;
+  }
+  // Umeyama (1991): cov = U D V^T, R = U S V^T, scale = trace(D S) / var_est.
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(cov, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::Vector3d d = svd.singularValues();
+  if (!(d(1) > 1e-12 * std::max(1.0, d(0)))) {
+    throw Error(
+        "the matched positions lie on a line (or a point): rotation alignment is undefined; "
+        "use --align origin or none");
+  }
+  Eigen::Vector3d s(1, 1, 1);
+  if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0) s(2) = -1;
+  r.T_gt_est.R = svd.matrixU() * s.asDiagonal() * svd.matrixV().transpose();
+  if (method == Alignment::sim3) r.scale = d.dot(s) / var_est;
+  r.T_gt_est.t = mean_gt - r.scale * (r.T_gt_est.R * mean_est);
+  return r;
+}
+
+SE3 apply(const AlignmentResult& alignment, const SE3& T_world_est) {
+  SE3 scaled = T_world_est;
+  scaled.t *= alignment.scale;
+  return alignment.T_gt_est * scaled;
+}
+
+PoseErrors absolute_errors(const std::vector<SE3>& T_world_gt,
+                           const std::vector<SE3>& T_world_est) {
+  PoseErrors e;
+  e.trans.resize(T_world_gt.size());
+  e.rot_deg.resize(T_world_gt.size());
+  for (size_t i = 0; i < T_world_gt.size(); ++i) {
+    e.trans[i] = (T_world_est[i].t - T_world_gt[i].t).norm();
+    e.rot_deg[i] = rotation_angle(T_world_gt[i].R.transpose() * T_world_est[i].R) * (180.0 / M_PI);
+  }
+  return e;
+}
+
+std::vector<double> cumulative_distances(const std::vector<SE3>& T_world_body) {
+  std::vector<double> dist(T_world_body.size(), 0.0);
+  for (size_t i = 1; i < T_world_body.size(); ++i) {
+    dist[i] = dist[i - 1] + (T_world_body[i].t - T_world_body[i - 1].t).norm();
+  }
+  return dist;
+}
+
+namespace {
+Segment relative_error(const std::vector<SE3>& gt, const std::vector<SE3>& est, size_t i, size_t j,
+                       double length) {
+  const SE3 dP_gt = gt[i].inverse() * gt[j];
+  const SE3 dP_est = est[i].inverse() * est[j];
+  const SE3 E = dP_est.inverse() * dP_gt;
+  return {i, j, length, E.t.norm(), rotation_angle(E.R) * (180.0 / M_PI)};
+}
+}  // namespace
+
+std::vector<Segment> length_segments(const std::vector<SE3>& T_world_gt,
+                                     const std::vector<SE3>& T_world_est,
+                                     const std::vector<double>& lengths, size_t step) {
+  std::vector<Segment> segments;
+  const std::vector<double> dist = cumulative_distances(T_world_gt);
+  for (size_t first = 0; first < dist.size(); first += step) {
+    for (double len : lengths) {
+      // The first pose farther than `len` along the GT path (the KITTI devkit's rule).
+      const auto it = std::upper_bound(dist.begin() + first, dist.end(), dist[first] + len);
+      if (it == dist.end()) continue;
+      segments.push_back(relative_error(T_world_gt, T_world_est, first, it - dist.begin(), len));
+    }
+  }
+  return segments;
+}
+
+std::vector<Segment> frame_deltas(const std::vector<SE3>& T_world_gt,
+                                  const std::vector<SE3>& T_world_est, size_t delta) {
+  std::vector<Segment> segments;
+  if (delta == 0) throw Error("the RPE delta must be at least 1 frame");
+  const std::vector<double> dist = cumulative_distances(T_world_gt);
+  for (size_t i = 0; i + delta < T_world_gt.size(); i += delta) {
+    // evo's RPE: E = inv(dQ) * dP (the inverse of the KITTI form; same norms).
+    const SE3 dQ = T_world_gt[i].inverse() * T_world_gt[i + delta];
+    const SE3 dP = T_world_est[i].inverse() * T_world_est[i + delta];
+    const SE3 E = dQ.inverse() * dP;
+    segments.push_back({i, i + delta, dist[i + delta] - dist[i], E.t.norm(),
+                        rotation_angle(E.R) * (180.0 / M_PI)});
+  }
+  return segments;
+}
+
+Drift pooled_drift(const std::vector<Segment>& segments) {
+  Drift d;
+  d.n_segments = segments.size();
+  if (segments.empty()) return d;
+  double t = 0.0, r = 0.0;
+  for (const Segment& s : segments) {
+    t += s.trans / s.length;
+    r += s.rot_deg / s.length;
+  }
+  d.trans_pct = 100.0 * t / static_cast<double>(segments.size());
+  d.rot_deg_per_m = r / static_cast<double>(segments.size());
+  return d;
+}
+
+}  // namespace rigcal::bench

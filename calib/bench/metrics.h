@@ -1,0 +1,93 @@
+#pragma once
+// Trajectory metrics: association, alignment, ATE and RPE (doc/bench.md). Plain functions on
+// rigcal::Trajectory; conventions of other tools (evo, KITTI devkit, VBR evaluator) are selected
+// in calib/bench/evaluate.h.
+#include <vector>
+
+#include "rigcal/core/trajectory.h"
+
+namespace rigcal::bench {
+
+// ---- statistics -------------------------------------------------------------------------------
+struct Stats {
+  size_t n = 0;
+  double rmse = 0, mean = 0, median = 0, std = 0, min = 0, max = 0, sse = 0;  // std: population
+};
+Stats statistics(const std::vector<double>& values);
+
+// ---- association --------------------------------------------------------------------------------
+struct Matches {
+  std::vector<size_t> gt, est;  // pairs: gt[k] with est[k]
+};
+// For every stamp of `a`, the nearest stamp of `b` within max_diff (ties: the earlier). O(N log M).
+// Several stamps of `a` may take the same stamp of `b` (evo's rule). Returned as (a, b) pairs.
+std::vector<std::pair<size_t, size_t>> nearest_stamps(const std::vector<Time>& a,
+                                                      const std::vector<Time>& b, Time max_diff);
+// evo: the shorter trajectory's stamps each take their nearest in the longer one.
+Matches associate_evo(const Trajectory& gt, const Trajectory& est, Time max_diff);
+// One-to-one (TUM associate.py): all pairs within max_diff, taken greedily by increasing |dt|.
+Matches associate_one_to_one(const Trajectory& gt, const Trajectory& est, Time max_diff);
+// By index, for files without stamps: the first min(N, M) poses.
+Matches associate_by_index(const Trajectory& gt, const Trajectory& est);
+// The ground truth interpolated (slerp + linear) at each estimate stamp that falls inside a GT
+// interval no longer than max_gap; returns the matched estimate indices and the GT poses there.
+struct Interpolated {
+  std::vector<size_t> est;
+  std::vector<SE3> T_world_gt;
+};
+Interpolated interpolate_gt(const Trajectory& gt, const Trajectory& est, Time max_gap);
+SE3 interpolate(const SE3& T_a, const SE3& T_b, double fraction);
+
+// ---- alignment ----------------------------------------------------------------------------------
+enum class Alignment { se3, sim3, yaw, origin, none };
+Alignment alignment_from_string(std::string_view name);  // se3|sim3|yaw|origin|none
+std::string_view to_string(Alignment alignment);
+
+struct AlignmentResult {
+  Alignment method = Alignment::none;
+  SE3 T_gt_est;        // maps estimate world coordinates into the GT world frame
+  double scale = 1.0;  // applied to estimate positions before T_gt_est (sim3 only)
+  size_t n_used = 0;
+};
+// p_gt ~ scale * R * p_est + t over the first n poses (0: all). Umeyama for se3/sim3, yaw about z
+// with translation for yaw (4-DoF, gravity-aligned frames), first poses for origin. Throws
+// rigcal::Error on degenerate input (fewer than 3 poses, all positions on a line).
+AlignmentResult align(const std::vector<SE3>& T_world_gt, const std::vector<SE3>& T_world_est,
+                      Alignment method, size_t n_first = 0);
+// The estimate pose in the GT world: T_gt_est * (scaled estimate pose).
+SE3 apply(const AlignmentResult& alignment, const SE3& T_world_est);
+
+// ---- errors -------------------------------------------------------------------------------------
+struct PoseErrors {
+  std::vector<double> trans;    // m
+  std::vector<double> rot_deg;  // deg
+};
+// ATE: E_i = inv(gt_i) * est_i for aligned, associated poses.
+PoseErrors absolute_errors(const std::vector<SE3>& T_world_gt, const std::vector<SE3>& T_world_est);
+
+// One relative-error segment: poses first..last, GT path length between them.
+struct Segment {
+  size_t first = 0, last = 0;
+  double length = 0;   // m (the nominal length for KITTI/VBR kinds, the GT distance for deltas)
+  double trans = 0;    // m (|t(E)|)
+  double rot_deg = 0;  // deg (angle(E))
+};
+// Segments of fixed lengths, KITTI-style: starts every `step` frames; a segment ends at the first
+// pose whose GT distance from the start exceeds the length. E = inv(dP_est) * dP_gt.
+std::vector<Segment> length_segments(const std::vector<SE3>& T_world_gt,
+                                     const std::vector<SE3>& T_world_est,
+                                     const std::vector<double>& lengths, size_t step);
+// evo-style deltas: consecutive pairs (i, i + delta) of frames; E = inv(dQ) * dP.
+std::vector<Segment> frame_deltas(const std::vector<SE3>& T_world_gt,
+                                  const std::vector<SE3>& T_world_est, size_t delta);
+
+// Pooled drift of segments: mean of trans/length (as % with 100) and rot/length (deg/m).
+struct Drift {
+  size_t n_segments = 0;
+  double trans_pct = 0, rot_deg_per_m = 0;
+};
+Drift pooled_drift(const std::vector<Segment>& segments);
+
+std::vector<double> cumulative_distances(const std::vector<SE3>& T_world_body);
+
+}  // namespace rigcal::bench

@@ -1,0 +1,262 @@
+#include "rigcal/io/bench_report.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "rigcal/core/error.h"
+#include "rigcal/core/version.h"
+#include "rigcal/io/files.h"
+#include "rigcal/io/svg_plot.h"
+
+namespace rigcal::io {
+namespace fs = std::filesystem;
+
+namespace {
+
+nlohmann::json stats_json(const bench::Stats& s) {
+  return {{"n", s.n},     {"rmse", s.rmse}, {"mean", s.mean}, {"median", s.median},
+          {"std", s.std}, {"min", s.min},   {"max", s.max},   {"sse", s.sse}};
+}
+
+// JSON has no infinity: failed entries become null.
+nlohmann::json number_or_null(bool ok, double v) {
+  return ok && std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
+}
+
+}  // namespace
+
+nlohmann::json bench_json(const bench::EvalResult& r,
+                          const std::map<std::string, std::string>& inputs) {
+  nlohmann::json j;
+  j["tool_version"] = version_string();
+  j["convention"] = bench::to_string(r.convention);
+  j["inputs"] = inputs;
+  j["association"] = bench::to_string(r.association);
+  j["n_gt"] = r.n_gt;
+  j["n_est"] = r.n_est;
+  j["n_pairs"] = r.n_pairs;
+  j["gt_length_m"] = r.gt_length;
+  const Eigen::Matrix4d T = r.alignment.T_gt_est.matrix();
+  nlohmann::json rows = nlohmann::json::array();
+  for (int i = 0; i < 4; ++i) rows.push_back({T(i, 0), T(i, 1), T(i, 2), T(i, 3)});
+  j["align"] = {{"method", bench::to_string(r.alignment.method)},
+                {"T", rows},
+                {"scale", r.alignment.scale},
+                {"n_used", r.alignment.n_used}};
+  j["ate"]["trans"] = stats_json(r.ate_trans);
+  j["ate"]["rot"] = stats_json(r.ate_rot_deg);
+  if (r.vbr_ate_trans) {
+    j["ate"]["trans"]["vbr_sqrt_mean"] = *r.vbr_ate_trans;
+    j["ate"]["rot"]["vbr_sqrt_mean"] = *r.vbr_ate_rot;
+  }
+  for (const bench::RpeResult& rpe : r.rpe) {
+    nlohmann::json k;
+    k["definition"] = rpe.definition;
+    k["n_segments"] = rpe.drift.n_segments;
+    if (rpe.kind != "delta") {
+      k["trans_pct"] = rpe.drift.trans_pct;
+      k["rot_deg_per_m"] = rpe.drift.rot_deg_per_m;
+      k["rot_rad_per_m"] = rpe.drift.rot_deg_per_m * M_PI / 180.0;
+    }
+    if (rpe.trans.n > 0) {
+      k["trans"] = stats_json(rpe.trans);
+      k["rot"] = stats_json(rpe.rot_deg);
+    }
+    if (!rpe.segments.empty()) {
+      nlohmann::json segs = nlohmann::json::array();
+      for (const bench::Segment& s : rpe.segments) {
+        segs.push_back({s.first, s.last, s.length, s.trans, s.rot_deg});
+      }
+      k["segments"] = {{"columns", {"first", "last", "length_m", "trans_m", "rot_deg"}},
+                       {"rows", segs}};
+    }
+    j["rpe"][rpe.kind] = k;
+  }
+  j["notes"] = r.notes;
+  return j;
+}
+
+void write_bench_report(const bench::EvalResult& r, const fs::path& dir,
+                        const std::map<std::string, std::string>& inputs) {
+  Plot top;
+  top.title = "Trajectories, top view (estimate coloured by ATE)";
+  top.x_label = "x [m]";
+  top.y_label = "y [m]";
+  top.value_label = "ATE [m]";
+  top.equal_axes = true;
+  PlotSeries gt{"ground truth", {}, {}, {}}, est{"estimate", {}, {}, r.ate_trans_errors};
+  for (size_t i = 0; i < r.p_gt.size(); ++i) {
+    gt.x.push_back(r.p_gt[i].x()), gt.y.push_back(r.p_gt[i].y());
+    est.x.push_back(r.p_est_aligned[i].x()), est.y.push_back(r.p_est_aligned[i].y());
+  }
+  top.series = {gt, est};
+  Plot along;
+  along.title = "ATE along the trajectory";
+  along.x_label = "time since the first pair [s]";
+  along.y_label = "translation error [m]";
+  PlotSeries e{"ATE", {}, r.ate_trans_errors, {}};
+  for (const Time& t : r.stamps) e.x.push_back((t - r.stamps.front()).seconds());
+  along.series = {e};
+  write_files_atomic({{dir / "bench.json", bench_json(r, inputs).dump(2) + "\n"},
+                      {dir / "trajectory_top.svg", render_svg(top)},
+                      {dir / "ate_along.svg", render_svg(along)}});
+}
+
+bench::LeaderboardInput load_leaderboard_input(const fs::path& gt_dir, const fs::path& est_dir,
+                                               const std::string& methods,
+                                               const TrajectoryReadOptions& read_options,
+                                               bench::LeaderboardInput in) {
+  std::error_code ec;
+  if (!fs::is_directory(gt_dir, ec)) throw Error(fmt::format("{}: not a folder", gt_dir.string()));
+  if (!fs::is_directory(est_dir, ec))
+    throw Error(fmt::format("{}: not a folder", est_dir.string()));
+  for (const auto& entry : fs::directory_iterator(gt_dir)) {
+    const std::string name = entry.path().filename().string();
+    const std::string suffix = "_gt.txt";
+    if (name.size() > suffix.size() && name.substr(name.size() - suffix.size()) == suffix) {
+      in.sequences.push_back(name.substr(0, name.size() - suffix.size()));
+    }
+  }
+  std::sort(in.sequences.begin(), in.sequences.end());
+  if (in.sequences.empty())
+    throw Error(fmt::format("{}: no <sequence>_gt.txt files", gt_dir.string()));
+  for (const std::string& seq : in.sequences) {
+    in.ground_truths.push_back(
+        read_trajectory(gt_dir / (seq + "_gt.txt"), read_options).trajectory);
+  }
+  std::vector<fs::path> folders;
+  if (methods.empty()) {
+    in.methods = {est_dir.filename().string()};
+    folders = {est_dir};
+  } else {
+    size_t start = 0;
+    while (start <= methods.size()) {
+      const size_t comma = std::min(methods.find(',', start), methods.size());
+      const std::string m = methods.substr(start, comma - start);
+      if (!m.empty()) {
+        in.methods.push_back(m);
+        folders.push_back(est_dir / m);
+      }
+      start = comma + 1;
+    }
+  }
+  for (const fs::path& folder : folders) {
+    in.estimates.emplace_back();
+    in.problems.emplace_back();
+    for (const std::string& seq : in.sequences) {
+      const fs::path file = folder / (seq + "_es.txt");
+      try {
+        if (!fs::exists(file)) throw Error(fmt::format("missing {}", file.string()));
+        in.estimates.back().push_back(read_trajectory(file, read_options).trajectory);
+        in.problems.back().emplace_back();
+      } catch (const Error& e) {
+        in.estimates.back().emplace_back(std::nullopt);
+        in.problems.back().push_back(e.what());
+      }
+    }
+  }
+  return in;
+}
+
+std::string leaderboard_markdown(const bench::Leaderboard& b) {
+  std::string out = fmt::format(
+      "| rank | method | RPE rank | ATE rank | failed |{}\n|---|---|---|---|---|{}\n",
+      fmt::format("{}", fmt::join(b.sequences, " RPE % / ATE m |")) +
+          (b.sequences.empty() ? "" : " RPE % / ATE m |"),
+      std::string(b.sequences.size() * 4, '-').empty() ? "" : [&] {
+        std::string s;
+        for (size_t i = 0; i < b.sequences.size(); ++i) s += "---|";
+        return s;
+      }());
+  for (size_t i = 0; i < b.rows.size(); ++i) {
+    const bench::MethodRow& row = b.rows[i];
+    out += fmt::format("| {} | {} | {:.4f} | {:.4f} | {} |", i + 1, row.method, row.rpe_rank,
+                       row.ate_rank, row.n_failed);
+    for (const bench::Entry& e : row.entries) {
+      out += e.ok ? fmt::format(" {:.4f} / {:.4f} |", e.rpe_pct, e.ate) : " failed |";
+    }
+    out += "\n";
+  }
+  out += fmt::format(
+      "\nConvention {}. RPE: {}; ATE: {}. Rank = sum over sequences of max(0, threshold - error) "
+      "(RPE threshold {} %, ATE threshold {} m): the area under the cumulative curve up to the "
+      "threshold. Failed or missing sequences add 0.\n",
+      bench::to_string(b.convention), b.rpe_definition, b.ate_definition, b.rpe_max, b.ate_max);
+  return out;
+}
+
+std::string leaderboard_csv(const bench::Leaderboard& b) {
+  std::string out = "method,sequence,ok,rpe_trans_pct,rpe_rot_deg_per_m,ate_m,problem\n";
+  for (const bench::MethodRow& row : b.rows) {
+    for (size_t s = 0; s < b.sequences.size(); ++s) {
+      const bench::Entry& e = row.entries[s];
+      std::string problem = e.problem;
+      std::replace(problem.begin(), problem.end(), '"', '\'');
+      out += fmt::format("{},{},{},{},{},{},\"{}\"\n", row.method, b.sequences[s], e.ok ? 1 : 0,
+                         e.ok ? fmt::format("{}", e.rpe_pct) : "",
+                         e.ok ? fmt::format("{}", e.rpe_rot) : "",
+                         e.ok ? fmt::format("{}", e.ate) : "", problem);
+    }
+  }
+  return out;
+}
+
+nlohmann::json leaderboard_json(const bench::Leaderboard& b) {
+  nlohmann::json j;
+  j["tool_version"] = version_string();
+  j["convention"] = bench::to_string(b.convention);
+  j["sequences"] = b.sequences;
+  j["rpe_definition"] = b.rpe_definition;
+  j["ate_definition"] = b.ate_definition;
+  j["rpe_threshold_pct"] = b.rpe_max;
+  j["ate_threshold_m"] = b.ate_max;
+  for (const bench::MethodRow& row : b.rows) {
+    nlohmann::json m{{"method", row.method},
+                     {"rpe_rank", row.rpe_rank},
+                     {"ate_rank", row.ate_rank},
+                     {"n_failed", row.n_failed}};
+    for (size_t s = 0; s < b.sequences.size(); ++s) {
+      const bench::Entry& e = row.entries[s];
+      m["sequences"][b.sequences[s]] = {{"ok", e.ok},
+                                        {"rpe_trans_pct", number_or_null(e.ok, e.rpe_pct)},
+                                        {"rpe_rot_deg_per_m", number_or_null(e.ok, e.rpe_rot)},
+                                        {"ate_m", number_or_null(e.ok, e.ate)},
+                                        {"problem", e.problem}};
+    }
+    j["methods"].push_back(m);
+  }
+  return j;
+}
+
+void write_leaderboard_report(const bench::Leaderboard& b, const fs::path& dir) {
+  Plot ate, rpe;
+  ate.title = "Cumulative ATE: fraction of sequences under an error";
+  ate.x_label = "ATE [m]";
+  rpe.title = "Cumulative RPE: fraction of sequences under an error";
+  rpe.x_label = "RPE [%]";
+  ate.y_label = rpe.y_label = "fraction of sequences";
+  ate.step = rpe.step = true;
+  for (const bench::MethodRow& row : b.rows) {
+    std::vector<double> a, r;
+    for (const bench::Entry& e : row.entries) {
+      a.push_back(e.ok ? e.ate : INFINITY);
+      r.push_back(e.ok ? e.rpe_pct : INFINITY);
+    }
+    PlotSeries sa{row.method, {}, {}, {}}, sr{row.method, {}, {}, {}};
+    for (const auto& [x, y] : bench::cumulative_curve(a, b.ate_max))
+      sa.x.push_back(x), sa.y.push_back(y);
+    for (const auto& [x, y] : bench::cumulative_curve(r, b.rpe_max))
+      sr.x.push_back(x), sr.y.push_back(y);
+    ate.series.push_back(sa);
+    rpe.series.push_back(sr);
+  }
+  write_files_atomic({{dir / "leaderboard.md", leaderboard_markdown(b)},
+                      {dir / "leaderboard.csv", leaderboard_csv(b)},
+                      {dir / "leaderboard.json", leaderboard_json(b).dump(2) + "\n"},
+                      {dir / "cumulative_ate.svg", render_svg(ate)},
+                      {dir / "cumulative_rpe.svg", render_svg(rpe)}});
+}
+
+}  // namespace rigcal::io

@@ -1,0 +1,167 @@
+#include "rigcal/io/svg_plot.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace rigcal::io {
+namespace {
+
+constexpr double kW = 900, kH = 620, kLeft = 80, kRight = 150, kTop = 50, kBottom = 60;
+constexpr const char* kPalette[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd",
+                                    "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"};
+
+std::string escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '<')
+      out += "&lt;";
+    else if (c == '>')
+      out += "&gt;";
+    else if (c == '&')
+      out += "&amp;";
+    else
+      out += c;
+  }
+  return out;
+}
+
+// Viridis, five anchors, linear in between.
+std::string viridis(double f) {
+  static const double anchors[5][3] = {
+      {68, 1, 84}, {59, 82, 139}, {33, 145, 140}, {94, 201, 98}, {253, 231, 37}};
+  f = std::clamp(std::isfinite(f) ? f : 0.0, 0.0, 1.0) * 4.0;
+  const int i = std::min(3, static_cast<int>(f));
+  const double t = f - i;
+  int rgb[3];
+  for (int k = 0; k < 3; ++k)
+    rgb[k] = static_cast<int>(anchors[i][k] + t * (anchors[i + 1][k] - anchors[i][k]));
+  return fmt::format("#{:02x}{:02x}{:02x}", rgb[0], rgb[1], rgb[2]);
+}
+
+double nice_step(double range, int target) {
+  const double raw = range / target;
+  const double mag = std::pow(10.0, std::floor(std::log10(raw)));
+  for (double m : {1.0, 2.0, 5.0, 10.0}) {
+    if (raw <= m * mag) return m * mag;
+  }
+  return 10 * mag;
+}
+
+}  // namespace
+
+std::string render_svg(const Plot& plot) {
+  double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
+  double v0 = x0, v1 = -x0;
+  for (const PlotSeries& s : plot.series) {
+    for (size_t i = 0; i < s.x.size(); ++i) {
+      if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
+      x0 = std::min(x0, s.x[i]), x1 = std::max(x1, s.x[i]);
+      y0 = std::min(y0, s.y[i]), y1 = std::max(y1, s.y[i]);
+    }
+    for (double v : s.values) {
+      if (std::isfinite(v)) v0 = std::min(v0, v), v1 = std::max(v1, v);
+    }
+  }
+  if (!std::isfinite(x0)) x0 = 0, x1 = 1, y0 = 0, y1 = 1;
+  if (x1 - x0 < 1e-12) x0 -= 0.5, x1 += 0.5;
+  if (y1 - y0 < 1e-12) y0 -= 0.5, y1 += 0.5;
+  const double pw = kW - kLeft - kRight, ph = kH - kTop - kBottom;
+  double sx = pw / (x1 - x0), sy = ph / (y1 - y0);
+  if (plot.equal_axes) {
+    const double s = std::min(sx, sy);
+    const double cx = 0.5 * (x0 + x1), cy = 0.5 * (y0 + y1);
+    sx = sy = s;
+    x0 = cx - pw / (2 * s), x1 = cx + pw / (2 * s);
+    y0 = cy - ph / (2 * s), y1 = cy + ph / (2 * s);
+  }
+  auto X = [&](double x) { return kLeft + (x - x0) * sx; };
+  auto Y = [&](double y) { return kTop + ph - (y - y0) * sy; };
+
+  std::string out = fmt::format(
+      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" height=\"{}\" "
+      "font-family=\"sans-serif\" "
+      "font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n",
+      kW, kH);
+  out += fmt::format("<text x=\"{}\" y=\"28\" font-size=\"16\" text-anchor=\"middle\">{}</text>\n",
+                     kLeft + pw / 2, escape(plot.title));
+  // Grid and ticks.
+  const double xs = nice_step(x1 - x0, 8), ys = nice_step(y1 - y0, 8);
+  for (double x = std::ceil(x0 / xs) * xs; x <= x1 + 1e-9 * xs; x += xs) {
+    out += fmt::format(
+        "<line x1=\"{0:.1f}\" y1=\"{1:.1f}\" x2=\"{0:.1f}\" y2=\"{2:.1f}\" stroke=\"#e0e0e0\"/>"
+        "<text x=\"{0:.1f}\" y=\"{3:.1f}\" text-anchor=\"middle\">{4:g}</text>\n",
+        X(x), kTop, kTop + ph, kTop + ph + 16, std::abs(x) < 1e-12 * xs ? 0.0 : x);
+  }
+  for (double y = std::ceil(y0 / ys) * ys; y <= y1 + 1e-9 * ys; y += ys) {
+    out += fmt::format(
+        "<line x1=\"{1:.1f}\" y1=\"{0:.1f}\" x2=\"{2:.1f}\" y2=\"{0:.1f}\" stroke=\"#e0e0e0\"/>"
+        "<text x=\"{3:.1f}\" y=\"{4:.1f}\" text-anchor=\"end\">{5:g}</text>\n",
+        Y(y), kLeft, kLeft + pw, kLeft - 6, Y(y) + 4, std::abs(y) < 1e-12 * ys ? 0.0 : y);
+  }
+  out += fmt::format(
+      "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"black\"/>\n",
+      kLeft, kTop, pw, ph);
+  out += fmt::format("<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{}</text>\n", kLeft + pw / 2,
+                     kH - 18, escape(plot.x_label));
+  out += fmt::format(
+      "<text transform=\"translate(20 {}) rotate(-90)\" text-anchor=\"middle\">{}</text>\n",
+      kTop + ph / 2, escape(plot.y_label));
+  out += fmt::format(
+      "<clipPath id=\"area\"><rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\"/></clipPath>\n<g "
+      "clip-path=\"url(#area)\">\n",
+      kLeft, kTop, pw, ph);
+  for (size_t k = 0; k < plot.series.size(); ++k) {
+    const PlotSeries& s = plot.series[k];
+    const size_t stride = std::max<size_t>(1, s.x.size() / 4000);
+    if (!s.values.empty()) {
+      for (size_t i = 0; i < s.x.size(); i += stride) {
+        const double f = v1 > v0 ? (s.values[i] - v0) / (v1 - v0) : 0.0;
+        out += fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"2\" fill=\"{}\"/>\n", X(s.x[i]),
+                           Y(s.y[i]), viridis(f));
+      }
+      continue;
+    }
+    std::string points;
+    for (size_t i = 0; i < s.x.size(); i += stride) {
+      if (!std::isfinite(s.y[i])) continue;
+      if (plot.step && !points.empty())
+        points += fmt::format("{:.1f},{:.1f} ", X(s.x[i]), Y(s.y[i - stride]));
+      points += fmt::format("{:.1f},{:.1f} ", X(s.x[i]), Y(s.y[i]));
+    }
+    out +=
+        fmt::format("<polyline fill=\"none\" stroke=\"{}\" stroke-width=\"1.5\" points=\"{}\"/>\n",
+                    kPalette[k % 10], points);
+  }
+  out += "</g>\n";
+  // Legend and colour bar on the right.
+  double ly = kTop + 10;
+  for (size_t k = 0; k < plot.series.size(); ++k) {
+    if (!plot.series[k].values.empty() || plot.series[k].label.empty()) continue;
+    out += fmt::format(
+        "<line x1=\"{0}\" y1=\"{1}\" x2=\"{2}\" y2=\"{1}\" stroke=\"{3}\" stroke-width=\"3\"/>"
+        "<text x=\"{4}\" y=\"{5}\">{6}</text>\n",
+        kW - kRight + 10, ly, kW - kRight + 30, kPalette[k % 10], kW - kRight + 35, ly + 4,
+        escape(plot.series[k].label));
+    ly += 18;
+  }
+  if (std::isfinite(v0)) {
+    const double bx = kW - kRight + 20, bh = ph * 0.6, by = kTop + ph * 0.3;
+    for (int i = 0; i < 50; ++i) {
+      out +=
+          fmt::format("<rect x=\"{}\" y=\"{:.1f}\" width=\"16\" height=\"{:.1f}\" fill=\"{}\"/>\n",
+                      bx, by + bh - (i + 1) * bh / 50, bh / 50 + 0.5, viridis(i / 49.0));
+    }
+    out +=
+        fmt::format("<text x=\"{}\" y=\"{}\">{:.3g}</text><text x=\"{}\" y=\"{}\">{:.3g}</text>\n",
+                    bx + 22, by + 4, v1, bx + 22, by + bh + 4, v0);
+    out += fmt::format("<text x=\"{}\" y=\"{}\">{}</text>\n", bx - 4, by - 10,
+                       escape(plot.value_label));
+  }
+  out += "</svg>\n";
+  return out;
+}
+
+}  // namespace rigcal::io

@@ -1,0 +1,25 @@
+#pragma once
+// Small SVG plots for reports: lines (one colour a series) or points coloured by a value with a
+// colour bar. Enough for trajectory top views, errors along a trajectory and cumulative curves;
+// files open in any browser. Long series are thinned to at most 4000 points a series.
+#include <string>
+#include <vector>
+
+namespace rigcal::io {
+
+struct PlotSeries {
+  std::string label;
+  std::vector<double> x, y;
+  std::vector<double> values;  // non-empty: draw points coloured by these (viridis), with a bar
+};
+
+struct Plot {
+  std::string title, x_label, y_label, value_label;
+  std::vector<PlotSeries> series;
+  bool equal_axes = false;  // same scale on x and y (top views)
+  bool step = false;        // draw lines as steps (cumulative curves)
+};
+
+std::string render_svg(const Plot& plot);
+
+}  // namespace rigcal::io

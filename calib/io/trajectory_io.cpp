@@ -1,0 +1,263 @@
+#include "rigcal/io/trajectory_io.h"
+
+#include <fmt/format.h>
+
+#include "rigcal/core/error.h"
+#include "rigcal/core/text.h"
+#include "rigcal/io/files.h"
+
+namespace rigcal::io {
+namespace {
+
+constexpr const char* kTumFields[] = {"t", "tx", "ty", "tz", "qx", "qy", "qz", "qw"};
+constexpr const char* kEurocFields[] = {"timestamp", "px", "py", "pz", "qw", "qx", "qy", "qz"};
+
+struct Line {
+  std::string_view text;
+  int number;  // 1-based
+};
+
+// Non-empty lines that are not comments; `headers` gets the comment and header lines.
+std::vector<Line> data_lines(std::string_view text, std::string* headers) {
+  std::vector<Line> lines;
+  int number = 0;
+  size_t pos = 0;
+  while (pos <= text.size()) {
+    size_t end = text.find('\n', pos);
+    if (end == std::string_view::npos) end = text.size();
+    std::string_view line = trim(text.substr(pos, end - pos));
+    ++number;
+    if (!line.empty()) {
+      if (line.front() == '#' ||
+          (lines.empty() && std::isalpha(static_cast<unsigned char>(line.front())))) {
+        if (headers) *headers += std::string(line) + "\n";
+      } else {
+        lines.push_back({line, number});
+      }
+    }
+    if (end == text.size()) break;
+    pos = end + 1;
+  }
+  return lines;
+}
+
+bool is_integer_text(std::string_view s) {
+  if (s.empty()) return false;
+  for (char c : s) {
+    if (c < '0' || c > '9') return false;
+  }
+  return true;
+}
+
+TrajectoryFormat detect(const std::vector<Line>& lines, const std::string& headers,
+                        std::string_view file_name) {
+  if (headers.find("[ns]") != std::string::npos || headers.find("p_RS_R") != std::string::npos) {
+    return TrajectoryFormat::euroc;
+  }
+  const std::vector<std::string_view> fields = split_fields(lines.front().text);
+  const bool csv = file_name.size() >= 4 && file_name.substr(file_name.size() - 4) == ".csv";
+  if (csv && fields.size() >= 8 && is_integer_text(fields[0])) return TrajectoryFormat::euroc;
+  if (fields.size() == 12) return TrajectoryFormat::kitti;
+  if (fields.size() == 8) return TrajectoryFormat::tum;
+  fail_at(file_name, lines.front().number, "",
+          fmt::format("cannot tell the trajectory format from {} fields (TUM has 8, KITTI 12, "
+                      "EuRoC CSV 8 or more with integer ns stamps); give --format",
+                      fields.size()));
+}
+
+[[noreturn]] void field_error(std::string_view file, int line, size_t field, std::string_view name,
+                              std::string_view what) {
+  fail_at(file, line, "", fmt::format("field {} ({}): {}", field + 1, name, what));
+}
+
+double number(std::string_view file, const Line& line, const std::vector<std::string_view>& f,
+              size_t i, std::string_view name) {
+  try {
+    return parse_double(f[i], name);
+  } catch (const Error&) {
+    field_error(file, line.number, i, name,
+                fmt::format("expected a finite number, got '{}'", f[i]));
+  }
+}
+
+Eigen::Quaterniond quaternion(std::string_view file, const Line& line, double w, double x, double y,
+                              double z) {
+  const Eigen::Quaterniond q(w, x, y, z);
+  const double norm = q.norm();
+  if (!(norm > 1e-6)) fail_at(file, line.number, "", "zero quaternion");
+  if (std::abs(norm - 1.0) > 1e-2) {
+    fail_at(file, line.number, "",
+            fmt::format("quaternion norm {:.6g} is far from 1: a wrong field order?", norm));
+  }
+  return q;
+}
+
+}  // namespace
+
+TrajectoryFormat trajectory_format_from_string(std::string_view name) {
+  for (TrajectoryFormat f : {TrajectoryFormat::automatic, TrajectoryFormat::tum,
+                             TrajectoryFormat::kitti, TrajectoryFormat::euroc}) {
+    if (name == to_string(f)) return f;
+  }
+  throw Error(
+      fmt::format("unknown trajectory format '{}'; expected auto, tum, kitti or euroc", name));
+}
+
+std::string_view to_string(TrajectoryFormat format) {
+  switch (format) {
+    case TrajectoryFormat::automatic:
+      return "auto";
+    case TrajectoryFormat::tum:
+      return "tum";
+    case TrajectoryFormat::kitti:
+      return "kitti";
+    case TrajectoryFormat::euroc:
+      return "euroc";
+  }
+  return "?";
+}
+
+TrajectoryFile parse_trajectory(std::string_view text, std::string_view file_name,
+                                const TrajectoryReadOptions& options) {
+  std::string headers;
+  const std::vector<Line> lines = data_lines(text, &headers);
+  if (lines.empty()) fail_at(file_name, 0, "", "no poses: the file is empty or all comments");
+  TrajectoryFile out;
+  out.format = options.format == TrajectoryFormat::automatic ? detect(lines, headers, file_name)
+                                                             : options.format;
+  Trajectory& traj = out.trajectory;
+  traj.stamps.reserve(lines.size());
+  traj.T_world_body.reserve(lines.size());
+  std::vector<int> line_of_pose;
+  line_of_pose.reserve(lines.size());
+
+  for (const Line& line : lines) {
+    const std::vector<std::string_view> f = split_fields(line.text);
+    SE3 T;
+    Time stamp;
+    switch (out.format) {
+      case TrajectoryFormat::tum: {
+        if (f.size() != 8) {
+          fail_at(
+              file_name, line.number, "",
+              fmt::format("expected 8 fields 't tx ty tz qx qy qz qw' (TUM), got {}", f.size()));
+        }
+        try {
+          stamp = parse_seconds(f[0], "t");
+        } catch (const Error&) {
+          field_error(file_name, line.number, 0, "t",
+                      fmt::format("expected seconds, got '{}'", f[0]));
+        }
+        double v[8];
+        for (size_t i = 1; i < 8; ++i) v[i] = number(file_name, line, f, i, kTumFields[i]);
+        T = SE3::from_quaternion(quaternion(file_name, line, v[7], v[4], v[5], v[6]),
+                                 Eigen::Vector3d(v[1], v[2], v[3]));
+        break;
+      }
+      case TrajectoryFormat::euroc: {
+        if (f.size() < 8) {
+          fail_at(file_name, line.number, "",
+                  fmt::format("expected at least 8 fields 'timestamp[ns], px, py, pz, qw, qx, qy, "
+                              "qz' (EuRoC), got {}",
+                              f.size()));
+        }
+        try {
+          stamp = parse_nanoseconds(f[0], "timestamp");
+        } catch (const Error&) {
+          field_error(file_name, line.number, 0, "timestamp",
+                      fmt::format("expected integer nanoseconds, got '{}'", f[0]));
+        }
+        double v[8];
+        for (size_t i = 1; i < 8; ++i) v[i] = number(file_name, line, f, i, kEurocFields[i]);
+        T = SE3::from_quaternion(quaternion(file_name, line, v[4], v[5], v[6], v[7]),
+                                 Eigen::Vector3d(v[1], v[2], v[3]));
+        break;
+      }
+      case TrajectoryFormat::kitti: {
+        if (f.size() != 12) {
+          fail_at(
+              file_name, line.number, "",
+              fmt::format("expected 12 numbers (KITTI: row-major 3x4 [R | t]), got {}", f.size()));
+        }
+        Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+        for (size_t i = 0; i < 12; ++i) {
+          m(i / 4, i % 4) =
+              number(file_name, line, f, i, fmt::format("r{}{}", i / 4 + 1, i % 4 + 1));
+        }
+        T = SE3::from_matrix(m);  // kept as read, as the KITTI devkit and evo use it
+        const double err = orthonormality_error(T.R);
+        if (err > 1e-3 || T.R.determinant() < 0) {
+          fail_at(file_name, line.number, "",
+                  fmt::format("the 3x3 block is not a rotation (max |R^T R - I| = {:.3g})", err));
+        }
+        stamp = Time{static_cast<int64_t>(traj.size()) * 1000000000LL};
+        break;
+      }
+      case TrajectoryFormat::automatic:
+        break;
+    }
+    if (out.format != TrajectoryFormat::kitti && !traj.stamps.empty() &&
+        stamp <= traj.stamps.back()) {
+      using D = TrajectoryReadOptions::Duplicates;
+      if (stamp == traj.stamps.back() && options.duplicates != D::error) {
+        ++out.duplicate_stamps;
+        if (options.duplicates == D::drop) continue;
+      } else {
+        fail_at(
+            file_name, line.number, "",
+            fmt::format("stamp {} is {} the previous one ({} s, line {}); stamps must increase{}",
+                        f[0], stamp == traj.stamps.back() ? "equal to" : "before",
+                        to_seconds_text(traj.stamps.back()), line_of_pose.back(),
+                        stamp == traj.stamps.back() ? " (--duplicate-stamps drop|keep)" : ""));
+      }
+    }
+    traj.stamps.push_back(stamp);
+    traj.T_world_body.push_back(T);
+    line_of_pose.push_back(line.number);
+  }
+
+  if (out.format == TrajectoryFormat::kitti) {
+    traj.has_stamps = false;
+    if (!options.kitti_times.empty()) {
+      const std::string times_text = read_text_file(options.kitti_times);
+      const std::string times_name = options.kitti_times.string();
+      const std::vector<Line> times = data_lines(times_text, nullptr);
+      if (times.size() != traj.size()) {
+        fail_at(times_name, 0, "",
+                fmt::format("{} times for {} poses of {}", times.size(), traj.size(), file_name));
+      }
+      for (size_t i = 0; i < times.size(); ++i) {
+        try {
+          traj.stamps[i] = parse_seconds(split_fields(times[i].text).at(0), "time");
+        } catch (const std::exception&) {
+          fail_at(times_name, times[i].number, "",
+                  fmt::format("expected a time in seconds, got '{}'", times[i].text));
+        }
+        if (i > 0 && traj.stamps[i] <= traj.stamps[i - 1]) {
+          fail_at(times_name, times[i].number, "", "times must increase");
+        }
+      }
+      traj.has_stamps = true;
+    }
+  }
+  return out;
+}
+
+TrajectoryFile read_trajectory(const std::filesystem::path& path,
+                               const TrajectoryReadOptions& options) {
+  return parse_trajectory(read_text_file(path), path.string(), options);
+}
+
+std::string trajectory_to_tum(const Trajectory& trajectory) {
+  std::string out;
+  out.reserve(trajectory.size() * 120);
+  for (size_t i = 0; i < trajectory.size(); ++i) {
+    out += to_seconds_text(trajectory.stamps[i]);
+    out += ' ';
+    out += to_text(trajectory.T_world_body[i]);
+    out += '\n';
+  }
+  return out;
+}
+
+}  // namespace rigcal::io

@@ -1,0 +1,45 @@
+#pragma once
+// Trajectory files (doc/formats.md):
+//   tum    "t tx ty tz qx qy qz qw", seconds; '#' comments; spaces, tabs or commas between fields
+//   kitti  12 numbers a line, the row-major 3x4 [R | t]; stamps from an optional times file
+//   euroc  CSV, "timestamp [ns], px, py, pz, qw, qx, qy, qz, ..." (w first), header lines '#'
+// Stamps are parsed exactly (calib/core/time.h), never through a double. Every error names the
+// file, the line and the field.
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+#include "rigcal/core/trajectory.h"
+
+namespace rigcal::io {
+
+enum class TrajectoryFormat { automatic, tum, kitti, euroc };
+TrajectoryFormat trajectory_format_from_string(std::string_view name);  // auto|tum|kitti|euroc
+std::string_view to_string(TrajectoryFormat format);
+
+struct TrajectoryReadOptions {
+  TrajectoryFormat format = TrajectoryFormat::automatic;
+  // KITTI: a file of one time (s) a line, as many lines as poses. Empty: frame indices.
+  std::filesystem::path kitti_times;
+  // Equal stamps: an error naming both lines (error), keep the first pose (drop), or keep them all
+  // (keep: what the VBR evaluator does; stamps then only need to be non-decreasing).
+  enum class Duplicates { error, drop, keep } duplicates = Duplicates::error;
+};
+
+struct TrajectoryFile {
+  Trajectory trajectory;
+  TrajectoryFormat format = TrajectoryFormat::tum;  // the format read (after detection)
+  size_t duplicate_stamps = 0;                      // dropped or kept, by `duplicates`
+};
+
+// Automatic detection: EuRoC when a header names "[ns]" or "p_RS_R", or when the file ends in
+// .csv and its stamps are integers; else 12 fields make KITTI and 8 make TUM.
+TrajectoryFile parse_trajectory(std::string_view text, std::string_view file_name,
+                                const TrajectoryReadOptions& options = {});
+TrajectoryFile read_trajectory(const std::filesystem::path& path,
+                               const TrajectoryReadOptions& options = {});
+
+// TUM text with stamps in seconds to the nanosecond, numbers lossless.
+std::string trajectory_to_tum(const Trajectory& trajectory);
+
+}  // namespace rigcal::io
