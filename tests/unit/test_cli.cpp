@@ -1,11 +1,15 @@
 // The command line as a user runs it: exit statuses, one-line errors, nothing written on failure.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
+
+#include "fixtures.h"
 
 namespace {
 
@@ -128,6 +132,93 @@ TEST_F(Cli, ConvertWritesEveryFormatAndNothingOnFailure) {
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("cam_r: mrcal 2.2 has no equidistant"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "mr" / "cam_l.cameramodel"));
+}
+
+// A helix: `drift` scales the estimate's path, `offset` shifts its stamps (s).
+std::string helix_tum(int n, double drift, double offset) {
+  std::string out;
+  for (int i = 0; i < n; ++i) {
+    const double s = 0.1 * i;
+    out += fmt::format("{:.9f} {} {} {} 0 0 {} {}\n", 1000.0 + s + offset,
+                       (1 + drift) * 3 * std::cos(0.05 * s) * s,
+                       (1 + drift) * 3 * std::sin(0.05 * s) * s, 0.01 * s, std::sin(0.025 * s),
+                       std::cos(0.025 * s));
+  }
+  return out;
+}
+
+TEST_F(Cli, BenchPrintsTableWritesReportAndRefusesBadFiles) {
+  const fs::path gt = write("seq_gt.txt", helix_tum(2000, 0.0, 0.0));
+  const fs::path est = write("seq_es.txt", helix_tum(2000, 0.01, 0.004));
+  CliRun r = run("bench --gt " + gt.string() + " --est " + est.string() + " --report " +
+                 (dir_ / "rep").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("ATE"), std::string::npos);
+  const nlohmann::json j = nlohmann::json::parse(slurp(dir_ / "rep" / "bench.json"));
+  EXPECT_EQ(j["convention"], "rigcal");
+  EXPECT_EQ(j["n_pairs"], 1999);  // stamps 4 ms late: the last one is past the GT's end
+  for (const char* key : {"rmse", "mean", "median", "std", "min", "max"}) {
+    EXPECT_TRUE(j["ate"]["trans"].contains(key)) << key;
+    EXPECT_TRUE(j["ate"]["rot"].contains(key)) << key;
+  }
+  // Positions scaled by 1.01: each segment errs by 1 % of its chord, which on this spiral is
+  // shorter than the path length the drift divides by: between 0.8 and 1 %.
+  const double drift = j["rpe"]["vbr"]["trans_pct"].get<double>();
+  EXPECT_GT(drift, 0.8);
+  EXPECT_LE(drift, 1.0 + 1e-9);
+  EXPECT_TRUE(j["rpe"]["kitti"].contains("rot_deg_per_m"));
+  EXPECT_EQ(j["align"]["T"].size(), 4u);
+  EXPECT_TRUE(fs::exists(dir_ / "rep" / "trajectory_top.svg"));
+  EXPECT_TRUE(fs::exists(dir_ / "rep" / "ate_along.svg"));
+
+  const fs::path bad = write("bad.txt", "1 0 0 0 0 0 0 1\n2 0 0 0 0 0 0 1\n1.5 0 0 0 0 0 0 1\n");
+  r = run("bench --gt " + gt.string() + " --est " + bad.string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.err, "rigcal: error: " + bad.string() +
+                       ":3: stamp 1.5 is before the previous one (2.000000000 s, line 2); stamps "
+                       "must increase\n");
+  const fs::path nan = write("nan.txt", "1 0 0 nan 0 0 0 1\n");
+  r = run("bench --gt " + gt.string() + " --est " + nan.string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("nan.txt:1: field 4 (tz)"), std::string::npos) << r.err;
+  const fs::path later = write("later.txt", helix_tum(10, 0.0, 5000.0));
+  r = run("bench --gt " + gt.string() + " --est " + later.string() + " --report " +
+          (dir_ / "none").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("do not overlap in time"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "none"));
+  EXPECT_EQ(run("bench --gt " + gt.string()).status, 2);
+  EXPECT_EQ(
+      run("bench --gt " + gt.string() + " --est " + est.string() + " --convention foo").status, 2);
+}
+
+TEST_F(Cli, BenchLeaderboardCountsMissingSequencesAsFailed) {
+  fs::create_directories(dir_ / "gt");
+  fs::create_directories(dir_ / "est" / "good");
+  fs::create_directories(dir_ / "est" / "poor");
+  for (const char* seq : {"a", "b"}) {
+    write(std::string("gt/") + seq + "_gt.txt", helix_tum(1500, 0.0, 0.0));
+    write(std::string("est/good/") + seq + "_es.txt", helix_tum(1500, 0.005, 0.0));
+  }
+  write("est/poor/a_es.txt", helix_tum(1500, 0.05, 0.0));  // b missing
+  const CliRun r =
+      run("bench --gt-dir " + (dir_ / "gt").string() + " --est-dir " + (dir_ / "est").string() +
+          " --methods good,poor --report " + (dir_ / "board").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(slurp(dir_ / "board" / "leaderboard.json"));
+  ASSERT_EQ(j["methods"].size(), 2u);
+  EXPECT_EQ(j["methods"][0]["method"], "good");  // best RPE rank first
+  EXPECT_EQ(j["methods"][1]["n_failed"], 1);
+  EXPECT_FALSE(j["methods"][1]["sequences"]["b"]["ok"].get<bool>());
+  EXPECT_NE(j["methods"][1]["sequences"]["b"]["problem"].get<std::string>().find("missing"),
+            std::string::npos);
+  // Ranks: sum of (10 - RPE %); good has two sequences near 0.5 %.
+  EXPECT_NEAR(j["methods"][0]["rpe_rank"].get<double>(), 2 * (10 - 0.5), 0.2);
+  for (const char* f :
+       {"leaderboard.md", "leaderboard.csv", "cumulative_ate.svg", "cumulative_rpe.svg"}) {
+    EXPECT_TRUE(fs::exists(dir_ / "board" / f)) << f;
+  }
+  EXPECT_NE(r.out.find("| 1 | good |"), std::string::npos) << r.out;
 }
 
 }  // namespace
