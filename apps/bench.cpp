@@ -67,11 +67,11 @@ void print_stats(std::string_view label, const bench::Stats& s) {
 }
 
 void run_pair(const Options& o) {
-  const io::TrajectoryFile gt = io::read_trajectory(o.gt, read_options(o, o.gt_format, o.gt_times));
-  const io::TrajectoryFile est =
-      io::read_trajectory(o.est, read_options(o, o.est_format, o.est_times));
+  io::TrajectoryFile gt = io::read_trajectory(o.gt, read_options(o, o.gt_format, o.gt_times));
+  io::TrajectoryFile est = io::read_trajectory(o.est, read_options(o, o.est_format, o.est_times));
   const bench::EvalOptions options = eval_options(o);
-  const bench::EvalResult r = bench::evaluate(gt.trajectory, est.trajectory, options);
+  const bench::EvalResult r =
+      bench::evaluate(std::move(gt.trajectory), std::move(est.trajectory), options);
 
   fmt::print("rigcal bench, convention {}\n", bench::to_string(r.convention));
   fmt::print("  ground truth {} ({} poses, {}{})\n", o.gt, r.n_gt, io::to_string(gt.format),

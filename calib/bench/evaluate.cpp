@@ -70,6 +70,35 @@ RpeResult make_rpe(std::string kind, std::string definition, std::vector<Segment
   return r;
 }
 
+// Like make_rpe for segments streamed from for_each_length_segment: keeps 16 bytes a segment
+// (for the medians) instead of the whole segment.
+RpeResult stream_rpe(std::string kind, std::string definition, const std::vector<SE3>& gt,
+                     const std::vector<SE3>& est, const std::vector<double>& lengths, size_t step,
+                     bool keep) {
+  RpeResult r;
+  r.kind = std::move(kind);
+  r.definition = std::move(definition);
+  std::vector<double> t, a;
+  const size_t at_most = (gt.size() + step - 1) / step * lengths.size();
+  t.reserve(at_most), a.reserve(at_most);  // no reallocation spikes on millions of segments
+  double t_rel = 0.0, r_rel = 0.0;
+  for_each_length_segment(gt, est, lengths, step, [&](const Segment& s) {
+    t.push_back(s.trans);
+    a.push_back(s.rot_deg);
+    t_rel += s.trans / s.length;
+    r_rel += s.rot_deg / s.length;
+    if (keep) r.segments.push_back(s);
+  });
+  r.drift.n_segments = t.size();
+  if (!t.empty()) {
+    r.drift.trans_pct = 100.0 * t_rel / static_cast<double>(t.size());
+    r.drift.rot_deg_per_m = r_rel / static_cast<double>(t.size());
+  }
+  r.trans = statistics(t);
+  r.rot_deg = statistics(a);
+  return r;
+}
+
 // ---- The VBR evaluator, reproduced in float (vbr_benchmark.cpp)
 // ----------------------------------
 struct VbrFigures {
@@ -210,35 +239,43 @@ const RpeResult* find_rpe(const EvalResult& result, std::string_view kind) {
   return nullptr;
 }
 
-EvalResult evaluate(const Trajectory& gt_in, const Trajectory& est_in, const EvalOptions& opt) {
-  if (gt_in.empty()) throw Error("the ground truth has no poses");
-  if (est_in.empty()) throw Error("the estimate has no poses");
+EvalResult evaluate(Trajectory gt, Trajectory est, const EvalOptions& opt) {
+  if (gt.empty()) throw Error("the ground truth has no poses");
+  if (est.empty()) throw Error("the estimate has no poses");
   EvalResult res;
   res.convention = opt.convention;
-  res.n_gt = gt_in.size();
-  res.n_est = est_in.size();
-  res.association = opt.association.value_or(default_association(opt.convention, gt_in, est_in));
+  res.n_gt = gt.size();
+  res.n_est = est.size();
+  res.association = opt.association.value_or(default_association(opt.convention, gt, est));
   const Alignment alignment = opt.alignment.value_or(default_alignment(opt.convention));
-
-  // rigcal re-orthonormalises rotations read with few digits; the peers use them as read.
-  Trajectory gt = gt_in, est = est_in;
-  if (opt.convention == Convention::rigcal) {
-    for (SE3& T : gt.T_world_body) T.R = nearest_rotation(T.R);
-    for (SE3& T : est.T_world_body) T.R = nearest_rotation(T.R);
-  }
   if (res.association != Association::index && (!gt.has_stamps || !est.has_stamps)) {
     throw Error(
         fmt::format("association '{}' needs stamps on both trajectories; KITTI files "
                     "without a times file pair by index",
                     to_string(res.association)));
   }
+  const std::string overlap =
+      gt.has_stamps && est.has_stamps
+          ? fmt::format("GT {}..{} s, estimate {}..{} s", to_seconds_text(gt.stamps.front()),
+                        to_seconds_text(gt.stamps.back()), to_seconds_text(est.stamps.front()),
+                        to_seconds_text(est.stamps.back()))
+          : std::string("no stamps");
 
-  // Matched pose lists.
+  std::optional<VbrFigures> vbr;
+  if (opt.convention == Convention::vbr) {
+    if (!gt.has_stamps || !est.has_stamps)
+      throw Error("the vbr convention needs stamped trajectories");
+    vbr = vbr_evaluator(gt, est);
+  }
+
+  // Matched poses. The inputs are released once matched: 1e6 poses are ~100 MB a copy.
   std::vector<SE3> m_gt, m_est;
   std::vector<Time> m_stamps;
   if (res.association == Association::interpolate) {
-    const Interpolated in = interpolate_gt(gt, est, opt.max_gap);
-    m_gt = in.T_world_gt;
+    Interpolated in = interpolate_gt(gt, est, opt.max_gap);
+    m_gt = std::move(in.T_world_gt);
+    m_est.reserve(in.est.size());
+    m_stamps.reserve(in.est.size());
     for (size_t i : in.est) {
       m_est.push_back(est.T_world_body[i]);
       m_stamps.push_back(est.stamps[i]);
@@ -247,19 +284,27 @@ EvalResult evaluate(const Trajectory& gt_in, const Trajectory& est_in, const Eva
         "ground truth interpolated (slerp + linear) at the estimate's stamps inside GT intervals "
         "up to {} s",
         opt.max_gap.seconds()));
-  } else if (opt.convention == Convention::vbr && res.association == Association::nearest) {
-    // Filled below from the evaluator's own walk.
+  } else if (vbr && res.association == Association::nearest) {
+    m_est.reserve(gt.size());
+    for (size_t i = 0; i < gt.size(); ++i) m_est.push_back(est.T_world_body[vbr->matched[i]]);
+    m_gt = std::move(gt.T_world_body);
+    m_stamps = std::move(gt.stamps);
+    res.notes.push_back(
+        "VBR evaluator: every GT pose takes the nearest estimate stamp, with no threshold; "
+        "stamps compared in float");
+  } else if (res.association == Association::index) {
+    if (gt.size() != est.size()) {
+      throw Error(
+          fmt::format("pairing by index needs as many poses in both: {} in the ground "
+                      "truth, {} in the estimate (give stamps, or a KITTI times file)",
+                      gt.size(), est.size()));
+    }
+    m_gt = std::move(gt.T_world_body);
+    m_est = std::move(est.T_world_body);
+    m_stamps = std::move(gt.stamps);
   } else {
     Matches m;
-    if (res.association == Association::index) {
-      if (gt.size() != est.size()) {
-        throw Error(
-            fmt::format("pairing by index needs as many poses in both: {} in the ground "
-                        "truth, {} in the estimate (give stamps, or a KITTI times file)",
-                        gt.size(), est.size()));
-      }
-      m = associate_by_index(gt, est);
-    } else if (res.association == Association::nearest) {
+    if (res.association == Association::nearest) {
       m = associate_evo(gt, est, opt.max_diff);
       res.notes.push_back(fmt::format(
           "each stamp of the shorter trajectory takes the nearest of the longer within {} s "
@@ -270,72 +315,61 @@ EvalResult evaluate(const Trajectory& gt_in, const Trajectory& est_in, const Eva
       res.notes.push_back(
           fmt::format("one-to-one pairs within {} s, closest first", opt.max_diff.seconds()));
     }
-    for (size_t k = 0; k < m.gt.size(); ++k) {
-      m_gt.push_back(gt.T_world_body[m.gt[k]]);
-      m_est.push_back(est.T_world_body[m.est[k]]);
-      m_stamps.push_back(gt.stamps[m.gt[k]]);
-    }
+    // One side at a time, releasing each input once copied: the peak holds one copy less.
+    m_gt.reserve(m.gt.size()), m_stamps.reserve(m.gt.size());
+    for (size_t k : m.gt) m_gt.push_back(gt.T_world_body[k]), m_stamps.push_back(gt.stamps[k]);
+    gt = Trajectory{};
+    m_est.reserve(m.est.size());
+    for (size_t k : m.est) m_est.push_back(est.T_world_body[k]);
   }
-
-  std::optional<VbrFigures> vbr;
-  if (opt.convention == Convention::vbr) {
-    if (!gt.has_stamps || !est.has_stamps)
-      throw Error("the vbr convention needs stamped trajectories");
-    vbr = vbr_evaluator(gt, est);
-    if (res.association == Association::nearest) {
-      for (size_t i = 0; i < gt.size(); ++i) {
-        m_gt.push_back(gt.T_world_body[i]);
-        m_est.push_back(est.T_world_body[vbr->matched[i]]);
-        m_stamps.push_back(gt.stamps[i]);
-      }
-      res.notes.push_back(
-          "VBR evaluator: every GT pose takes the nearest estimate stamp, with no threshold; "
-          "stamps compared in float");
-    }
-  }
+  gt = Trajectory{};
+  est = Trajectory{};
 
   res.n_pairs = m_gt.size();
   if (res.n_pairs == 0) {
     throw Error(
-        fmt::format("no pose pairs: the trajectories do not overlap in time (GT {}..{} s, "
-                    "estimate {}..{} s, association {})",
-                    to_seconds_text(gt.stamps.front()), to_seconds_text(gt.stamps.back()),
-                    to_seconds_text(est.stamps.front()), to_seconds_text(est.stamps.back()),
-                    to_string(res.association)));
+        fmt::format("no pose pairs: the trajectories do not overlap in time ({}, association {})",
+                    overlap, to_string(res.association)));
+  }
+  // rigcal re-orthonormalises rotations read with few digits; the peers use them as read.
+  if (opt.convention == Convention::rigcal) {
+    for (SE3& T : m_gt) T.R = nearest_rotation(T.R);
+    for (SE3& T : m_est) T.R = nearest_rotation(T.R);
   }
 
   res.alignment = align(m_gt, m_est, alignment, opt.align_first_n);
-  std::vector<SE3> m_est_aligned(m_est.size());
-  for (size_t i = 0; i < m_est.size(); ++i) m_est_aligned[i] = apply(res.alignment, m_est[i]);
+  for (SE3& T : m_est) T = apply(res.alignment, T);  // aligned in place from here on
 
-  const PoseErrors ate = absolute_errors(m_gt, m_est_aligned);
+  PoseErrors ate = absolute_errors(m_gt, m_est);
   res.ate_trans = statistics(ate.trans);
   res.ate_rot_deg = statistics(ate.rot_deg);
   res.gt_length = cumulative_distances(m_gt).back();
-  res.stamps = m_stamps;
-  res.ate_trans_errors = ate.trans;
-  for (size_t i = 0; i < m_gt.size(); ++i) {
-    res.p_gt.push_back(m_gt[i].t);
-    res.p_est_aligned.push_back(m_est_aligned[i].t);
+  if (opt.keep_segments) {
+    res.stamps = std::move(m_stamps);
+    res.ate_trans_errors = std::move(ate.trans);
+    for (size_t i = 0; i < m_gt.size(); ++i) {
+      res.p_gt.push_back(m_gt[i].t);
+      res.p_est_aligned.push_back(m_est[i].t);
+    }
   }
+  ate = PoseErrors{};
 
   const bool keep = opt.keep_segments;
+  const std::vector<double> kitti_lengths(std::begin(kKittiLengths), std::end(kKittiLengths));
   switch (opt.convention) {
     case Convention::rigcal: {
       std::vector<double> lengths;
       for (double f : kVbrFractions) lengths.push_back(f * res.gt_length);
       res.rpe.push_back(
-          make_rpe("kitti", "KITTI: segments of 100..800 m of GT path, a start every 10 frames",
-                   length_segments(m_gt, m_est_aligned,
-                                   {std::begin(kKittiLengths), std::end(kKittiLengths)}, 10),
-                   keep));
-      res.rpe.push_back(make_rpe(
+          stream_rpe("kitti", "KITTI: segments of 100..800 m of GT path, a start every 10 frames",
+                     m_gt, m_est, kitti_lengths, 10, keep));
+      res.rpe.push_back(stream_rpe(
           "vbr",
           "VBR: segments of 1, 2, 3, 5, 8, 13, 21, 34, 55 % of the GT length, every frame a start",
-          length_segments(m_gt, m_est_aligned, lengths, 1), keep));
+          m_gt, m_est, lengths, 1, keep));
       res.rpe.push_back(
           make_rpe("delta", fmt::format("consecutive pairs {} frame(s) apart", opt.delta_frames),
-                   frame_deltas(m_gt, m_est_aligned, opt.delta_frames), keep));
+                   frame_deltas(m_gt, m_est, opt.delta_frames), keep));
       res.notes.push_back(
           "rigcal: rotations re-orthonormalised; ATE is the true RMSE; RPE pooled over segments");
       break;
@@ -345,7 +379,7 @@ EvalResult evaluate(const Trajectory& gt_in, const Trajectory& est_in, const Eva
           make_rpe("delta",
                    fmt::format("evo_rpe: consecutive pairs {} frame(s) apart, E = inv(dQ) dP",
                                opt.delta_frames),
-                   frame_deltas(m_gt, m_est_aligned, opt.delta_frames), keep));
+                   frame_deltas(m_gt, m_est, opt.delta_frames), keep));
       res.notes.push_back(
           "evo: APE and RPE as evo_ape / evo_rpe compute them; rotation angles from the log map");
       break;
@@ -353,7 +387,7 @@ EvalResult evaluate(const Trajectory& gt_in, const Trajectory& est_in, const Eva
       res.rpe.push_back(make_rpe(
           "kitti",
           "KITTI devkit: 100..800 m every 10 frames, general inverses, acos angles, in double",
-          kitti_devkit_segments(m_gt, m_est_aligned), keep));
+          kitti_devkit_segments(m_gt, m_est), keep));
       res.notes.push_back("kitti: the devkit's metric in double (the devkit itself sums in float)");
       break;
     case Convention::vbr: {

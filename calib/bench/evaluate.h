@@ -56,14 +56,17 @@ struct EvalResult {
   std::optional<double> vbr_ate_trans, vbr_ate_rot;
   std::vector<RpeResult> rpe;
   std::vector<std::string> notes;  // what was computed, in words
-  // Per matched pose, for plots: stamps, GT and aligned estimate positions, ATE errors.
+  // Per matched pose, with keep_segments: stamps, GT and aligned estimate positions, ATE errors.
   std::vector<Time> stamps;
   std::vector<Eigen::Vector3d> p_gt, p_est_aligned;
   std::vector<double> ate_trans_errors;
 };
 
 // Throws rigcal::Error when the two do not overlap (no matched pairs) or alignment is degenerate.
-EvalResult evaluate(const Trajectory& gt, const Trajectory& est, const EvalOptions& options = {});
+// Takes the trajectories by value: move them in to keep the peak memory of long ones low.
+// Per-pose data for plots (stamps, positions, ATE errors) and segments are kept only with
+// options.keep_segments.
+EvalResult evaluate(Trajectory gt, Trajectory est, const EvalOptions& options = {});
 
 const RpeResult* find_rpe(const EvalResult& result, std::string_view kind);
 

@@ -256,19 +256,27 @@ Segment relative_error(const std::vector<SE3>& gt, const std::vector<SE3>& est, 
 }
 }  // namespace
 
-std::vector<Segment> length_segments(const std::vector<SE3>& T_world_gt,
-                                     const std::vector<SE3>& T_world_est,
-                                     const std::vector<double>& lengths, size_t step) {
-  std::vector<Segment> segments;
+void for_each_length_segment(const std::vector<SE3>& T_world_gt,
+                             const std::vector<SE3>& T_world_est,
+                             const std::vector<double>& lengths, size_t step,
+                             const std::function<void(const Segment&)>& visit) {
   const std::vector<double> dist = cumulative_distances(T_world_gt);
   for (size_t first = 0; first < dist.size(); first += step) {
     for (double len : lengths) {
       // The first pose farther than `len` along the GT path (the KITTI devkit's rule).
       const auto it = std::upper_bound(dist.begin() + first, dist.end(), dist[first] + len);
       if (it == dist.end()) continue;
-      segments.push_back(relative_error(T_world_gt, T_world_est, first, it - dist.begin(), len));
+      visit(relative_error(T_world_gt, T_world_est, first, it - dist.begin(), len));
     }
   }
+}
+
+std::vector<Segment> length_segments(const std::vector<SE3>& T_world_gt,
+                                     const std::vector<SE3>& T_world_est,
+                                     const std::vector<double>& lengths, size_t step) {
+  std::vector<Segment> segments;
+  for_each_length_segment(T_world_gt, T_world_est, lengths, step,
+                          [&](const Segment& s) { segments.push_back(s); });
   return segments;
 }
 

@@ -2,6 +2,7 @@
 // Trajectory metrics: association, alignment, ATE and RPE (doc/bench.md). Plain functions on
 // rigcal::Trajectory; conventions of other tools (evo, KITTI devkit, VBR evaluator) are selected
 // in calib/bench/evaluate.h.
+#include <functional>
 #include <vector>
 
 #include "rigcal/core/trajectory.h"
@@ -74,6 +75,11 @@ struct Segment {
 };
 // Segments of fixed lengths, KITTI-style: starts every `step` frames; a segment ends at the first
 // pose whose GT distance from the start exceeds the length. E = inv(dP_est) * dP_gt.
+// The visitor form streams them (millions for every-frame starts) without storing them.
+void for_each_length_segment(const std::vector<SE3>& T_world_gt,
+                             const std::vector<SE3>& T_world_est,
+                             const std::vector<double>& lengths, size_t step,
+                             const std::function<void(const Segment&)>& visit);
 std::vector<Segment> length_segments(const std::vector<SE3>& T_world_gt,
                                      const std::vector<SE3>& T_world_est,
                                      const std::vector<double>& lengths, size_t step);

@@ -7,7 +7,6 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
-#include <sstream>
 
 #include "rigcal/core/error.h"
 
@@ -20,14 +19,19 @@ std::string read_text_file(const fs::path& path) {
   if (fs::is_directory(path, ec)) {
     throw Error(fmt::format("{}: is a folder, expected a file", path.string()));
   }
-  std::ifstream in(path, std::ios::binary);
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) {
     throw Error(fmt::format("{}: cannot open: {}", path.string(), std::strerror(errno)));
   }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) throw Error(fmt::format("{}: read error", path.string()));
-  return ss.str();
+  // One allocation of the file's size (large trajectories are hundreds of MB).
+  const std::streamoff size = in.tellg();
+  std::string text(size > 0 ? static_cast<size_t>(size) : 0, '\0');
+  in.seekg(0);
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  if (in.bad() || in.gcount() != static_cast<std::streamsize>(text.size())) {
+    throw Error(fmt::format("{}: read error", path.string()));
+  }
+  return text;
 }
 
 fs::path temporary_sibling(const fs::path& path) {
