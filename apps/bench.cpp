@@ -18,7 +18,10 @@ namespace {
 struct Options {
   std::string gt, est, format = "auto", gt_format, est_format, gt_times, est_times;
   std::string align, association, convention = "rigcal", report;
-  size_t align_first = 0, delta = 1;
+  size_t align_first = 0;
+  double delta = 1;
+  std::string delta_unit = "f";
+  bool all_pairs = false;
   double max_diff = 0.01, max_gap = 0.5;
   std::string duplicates;
   // Leaderboard.
@@ -54,7 +57,15 @@ bench::EvalOptions eval_options(const Options& o) {
   e.align_first_n = o.align_first;
   e.max_diff = Time::from_seconds(o.max_diff);
   e.max_gap = Time::from_seconds(o.max_gap);
-  e.delta_frames = o.delta;
+  e.delta = o.delta;
+  if (o.delta_unit == "f" || o.delta_unit == "frames")
+    e.delta_unit = bench::DeltaUnit::frames;
+  else if (o.delta_unit == "m" || o.delta_unit == "meters")
+    e.delta_unit = bench::DeltaUnit::meters;
+  else
+    throw Error(
+        fmt::format("--delta-unit: expected f (frames) or m (metres), got '{}'", o.delta_unit));
+  e.all_pairs = o.all_pairs;
   e.keep_segments = !o.report.empty();
   return e;
 }
@@ -162,7 +173,11 @@ void add_bench(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--max-gap", o->max_gap, "interpolate: longest GT interval bridged, s")
       ->capture_default_str();
-  cmd->add_option("--delta", o->delta, "RPE frame delta (evo-style pairs)")->capture_default_str();
+  cmd->add_option("--delta", o->delta, "RPE delta of the evo-style pairs")->capture_default_str();
+  cmd->add_option("--delta-unit", o->delta_unit, "f (frames) | m (metres of the estimate's path)")
+      ->capture_default_str();
+  cmd->add_flag("--all-pairs", o->all_pairs,
+                "evo's --all_pairs: every start, not consecutive pairs");
   cmd->add_option(
       "--duplicate-stamps", o->duplicates,
       "poses with equal stamps: error | drop (keep the first) | keep (default: keep for\n"

@@ -70,6 +70,24 @@ RpeResult make_rpe(std::string kind, std::string definition, std::vector<Segment
   return r;
 }
 
+std::string delta_definition(const EvalOptions& o) {
+  return fmt::format("{} pairs {:g} {} apart{}", o.all_pairs ? "all" : "consecutive", o.delta,
+                     o.delta_unit == DeltaUnit::frames ? "frame(s)" : "m of the estimate's path",
+                     o.delta_unit == DeltaUnit::meters && o.all_pairs ? " (+-10 %)" : "");
+}
+
+std::vector<std::pair<size_t, size_t>> delta_pairs(const std::vector<SE3>& est,
+                                                   const EvalOptions& o) {
+  std::vector<std::pair<size_t, size_t>> pairs =
+      evo_delta_pairs(est, o.delta, o.delta_unit, o.all_pairs);
+  if (pairs.empty()) {
+    throw Error(fmt::format(
+        "RPE delta {:g} {} gives no pose pair on this trajectory; use a smaller --delta", o.delta,
+        o.delta_unit == DeltaUnit::frames ? "frames" : "m"));
+  }
+  return pairs;
+}
+
 // Like make_rpe for segments streamed from for_each_length_segment: keeps 16 bytes a segment
 // (for the medians) instead of the whole segment.
 RpeResult stream_rpe(std::string kind, std::string definition, const std::vector<SE3>& gt,
@@ -367,19 +385,15 @@ EvalResult evaluate(Trajectory gt, Trajectory est, const EvalOptions& opt) {
           "vbr",
           "VBR: segments of 1, 2, 3, 5, 8, 13, 21, 34, 55 % of the GT length, every frame a start",
           m_gt, m_est, lengths, 1, keep));
-      res.rpe.push_back(
-          make_rpe("delta", fmt::format("consecutive pairs {} frame(s) apart", opt.delta_frames),
-                   frame_deltas(m_gt, m_est, opt.delta_frames), keep));
+      res.rpe.push_back(make_rpe("delta", delta_definition(opt),
+                                 delta_errors(m_gt, m_est, delta_pairs(m_est, opt)), keep));
       res.notes.push_back(
           "rigcal: rotations re-orthonormalised; ATE is the true RMSE; RPE pooled over segments");
       break;
     }
     case Convention::evo:
-      res.rpe.push_back(
-          make_rpe("delta",
-                   fmt::format("evo_rpe: consecutive pairs {} frame(s) apart, E = inv(dQ) dP",
-                               opt.delta_frames),
-                   frame_deltas(m_gt, m_est, opt.delta_frames), keep));
+      res.rpe.push_back(make_rpe("delta", "evo_rpe: " + delta_definition(opt) + ", E = inv(dQ) dP",
+                                 delta_errors(m_gt, m_est, delta_pairs(m_est, opt)), keep));
       res.notes.push_back(
           "evo: APE and RPE as evo_ape / evo_rpe compute them; rotation angles from the log map");
       break;

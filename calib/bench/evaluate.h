@@ -33,7 +33,9 @@ struct EvalOptions {
   size_t align_first_n = 0;                   // 0: all matched poses
   Time max_diff = Time::from_ns(10'000'000);  // nearest / one-to-one: 10 ms (evo's default)
   Time max_gap = Time::from_ns(500'000'000);  // interpolate: longest GT interval bridged, 0.5 s
-  size_t delta_frames = 1;                    // evo-style RPE delta
+  double delta = 1;                           // evo-style RPE delta ...
+  DeltaUnit delta_unit = DeltaUnit::frames;   // ... in frames or metres
+  bool all_pairs = false;                     // evo's --all_pairs
   bool keep_segments = false;                 // keep per-segment rows (plots, reports)
 };
 

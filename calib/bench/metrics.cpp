@@ -280,20 +280,86 @@ std::vector<Segment> length_segments(const std::vector<SE3>& T_world_gt,
   return segments;
 }
 
-std::vector<Segment> frame_deltas(const std::vector<SE3>& T_world_gt,
-                                  const std::vector<SE3>& T_world_est, size_t delta) {
+std::vector<std::pair<size_t, size_t>> evo_delta_pairs(const std::vector<SE3>& T_world_est,
+                                                       double delta, DeltaUnit unit,
+                                                       bool all_pairs) {
+  std::vector<std::pair<size_t, size_t>> pairs;
+  const size_t n = T_world_est.size();
+  if (!(delta > 0)) throw Error("the RPE delta must be positive");
+  if (unit == DeltaUnit::frames) {
+    const size_t d = static_cast<size_t>(delta);
+    if (static_cast<double>(d) != delta) throw Error("a delta in frames must be a whole number");
+    for (size_t i = 0; i + d < n; i += all_pairs ? 1 : d) pairs.emplace_back(i, i + d);
+    return pairs;
+  }
+  const std::vector<double> dist = cumulative_distances(T_world_est);
+  if (!all_pairs) {
+    std::vector<size_t> ids;
+    double path = 0.0;
+    for (size_t i = 1; i < n; ++i) {
+      path += (T_world_est[i].t - T_world_est[i - 1].t).norm();
+      if (path >= delta) ids.push_back(i), path = 0.0;
+    }
+    for (size_t k = 0; k + 1 < ids.size(); ++k) pairs.emplace_back(ids[k], ids[k + 1]);
+    return pairs;
+  }
+  // evo's bounded_binary_search over j in [0, n) of the path length from i to j (0 for j < i).
+  const double lower = 0.9 * delta, upper = 1.1 * delta;
+  for (size_t i = 0; i < n; ++i) {
+    auto path = [&](long j) {
+      if (j <= static_cast<long>(i)) return 0.0;
+      return dist[std::min<size_t>(static_cast<size_t>(j), n - 1)] - dist[i];
+    };
+    long start = 0, end = static_cast<long>(n) - 1, mid = -1;
+    bool found = false;
+    while (start <= end && !found) {
+      mid = (start + end) / 2;
+      const double val = path(mid);
+      if (lower <= val && val <= upper) {
+        const double residual = std::abs(val - delta);
+        if (std::abs(path(mid - 1) - delta) <= residual) {
+          end = mid - 1;
+          continue;
+        }
+        if (std::abs(path(mid + 1) - delta) < residual) {
+          start = mid + 1;
+          continue;
+        }
+        found = true;
+      }
+      if (!found) {
+        if (delta < val)
+          end = mid - 1;
+        else
+          start = mid + 1;
+      }
+    }
+    if (found) pairs.emplace_back(i, static_cast<size_t>(mid));
+  }
+  return pairs;
+}
+
+std::vector<Segment> delta_errors(const std::vector<SE3>& T_world_gt,
+                                  const std::vector<SE3>& T_world_est,
+                                  const std::vector<std::pair<size_t, size_t>>& pairs) {
   std::vector<Segment> segments;
-  if (delta == 0) throw Error("the RPE delta must be at least 1 frame");
+  segments.reserve(pairs.size());
   const std::vector<double> dist = cumulative_distances(T_world_gt);
-  for (size_t i = 0; i + delta < T_world_gt.size(); i += delta) {
-    // evo's RPE: E = inv(dQ) * dP (the inverse of the KITTI form; same norms).
-    const SE3 dQ = T_world_gt[i].inverse() * T_world_gt[i + delta];
-    const SE3 dP = T_world_est[i].inverse() * T_world_est[i + delta];
+  for (const auto& [i, j] : pairs) {
+    const SE3 dQ = T_world_gt[i].inverse() * T_world_gt[j];
+    const SE3 dP = T_world_est[i].inverse() * T_world_est[j];
     const SE3 E = dQ.inverse() * dP;
-    segments.push_back({i, i + delta, dist[i + delta] - dist[i], E.t.norm(),
-                        rotation_angle(E.R) * (180.0 / M_PI)});
+    segments.push_back({i, j, dist[j] - dist[i], E.t.norm(), rotation_angle(E.R) * (180.0 / M_PI)});
   }
   return segments;
+}
+
+std::vector<Segment> frame_deltas(const std::vector<SE3>& T_world_gt,
+                                  const std::vector<SE3>& T_world_est, size_t delta) {
+  if (delta == 0) throw Error("the RPE delta must be at least 1 frame");
+  return delta_errors(
+      T_world_gt, T_world_est,
+      evo_delta_pairs(T_world_est, static_cast<double>(delta), DeltaUnit::frames, false));
 }
 
 Drift pooled_drift(const std::vector<Segment>& segments) {

@@ -83,7 +83,21 @@ void for_each_length_segment(const std::vector<SE3>& T_world_gt,
 std::vector<Segment> length_segments(const std::vector<SE3>& T_world_gt,
                                      const std::vector<SE3>& T_world_est,
                                      const std::vector<double>& lengths, size_t step);
-// evo-style deltas: consecutive pairs (i, i + delta) of frames; E = inv(dQ) * dP.
+// evo's RPE pairs, chosen on the estimate's poses (evo's default):
+//   frames, consecutive: (0, d), (d, 2d), ...; all pairs: (i, i + d) for every i.
+//   metres, consecutive: the poses where the estimate's path since the previous one reaches d;
+//   metres, all pairs: for each i, evo's bounded binary search for the j whose path length from i
+//   is nearest d within d +- 10 %.
+enum class DeltaUnit { frames, meters };
+std::vector<std::pair<size_t, size_t>> evo_delta_pairs(const std::vector<SE3>& T_world_est,
+                                                       double delta, DeltaUnit unit,
+                                                       bool all_pairs);
+// E = inv(dQ) * dP for each pair (the inverse of the KITTI form; same norms); `length` is the GT
+// path between the two poses.
+std::vector<Segment> delta_errors(const std::vector<SE3>& T_world_gt,
+                                  const std::vector<SE3>& T_world_est,
+                                  const std::vector<std::pair<size_t, size_t>>& pairs);
+// Consecutive frame pairs: delta_errors(gt, est, evo_delta_pairs(est, delta, frames, false)).
 std::vector<Segment> frame_deltas(const std::vector<SE3>& T_world_gt,
                                   const std::vector<SE3>& T_world_est, size_t delta);
 

@@ -39,6 +39,21 @@ TEST(BenchPeers, EvoOnKitti00MatchesToOneBillionth) {
   EXPECT_REL(find_rpe(r, "delta")->trans.rmse, 0.028120377017393464, 1e-9);
   EXPECT_REL(find_rpe(r, "delta")->trans.mean, 0.0193013, 1e-6);
   EXPECT_REL(find_rpe(r, "delta")->rot_deg.rmse, 0.1149735, 1e-6);
+  // evo_rpe ... -d 100 -u m (consecutive pairs on the estimate's path) and --all_pairs
+  o.delta = 100;
+  o.delta_unit = DeltaUnit::meters;
+  r = evaluate(gt, est, o);
+  EXPECT_REL(find_rpe(r, "delta")->trans.rmse, 1.1027416, 1e-7);
+  EXPECT_REL(find_rpe(r, "delta")->trans.mean, 1.0000447, 1e-7);
+  EXPECT_REL(find_rpe(r, "delta")->trans.max, 2.2929534, 1e-7);
+  o.all_pairs = true;
+  r = evaluate(gt, est, o);
+  EXPECT_REL(find_rpe(r, "delta")->trans.rmse, 1.2548300, 1e-7);
+  EXPECT_REL(find_rpe(r, "delta")->trans.mean, 1.0146945, 1e-7);
+  EXPECT_REL(find_rpe(r, "delta")->trans.max, 11.8150648, 1e-7);
+  o.delta = 1;
+  o.delta_unit = DeltaUnit::frames;
+  o.all_pairs = false;
   // -a -s (Sim3)
   o.alignment = Alignment::sim3;
   r = evaluate(gt, est, o);
