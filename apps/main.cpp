@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   rigcal::cli::add_rig_show(*rig);
   rigcal::cli::add_rig_convert(*rig);
   rigcal::cli::add_bench(app);
+  rigcal::cli::add_simulate(app);
 
   try {
     app.parse(argc, argv);

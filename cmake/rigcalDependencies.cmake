@@ -6,7 +6,9 @@ find_dependency(Eigen3 3.4 NO_MODULE)
 find_dependency(yaml-cpp)
 find_dependency(fmt)
 find_dependency(nlohmann_json 3)
-find_dependency(OpenCV 4 COMPONENTS core calib3d)
+find_dependency(OpenCV 4 COMPONENTS core calib3d imgproc imgcodecs)
+find_dependency(TBB)
+find_dependency(apriltag)
 
 # mrcal 2.2 ships no CMake or pkg-config file: one header folder and -lmrcal.
 if(NOT TARGET rigcal_mrcal)

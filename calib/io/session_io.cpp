@@ -1,0 +1,184 @@
+#include "rigcal/io/session_io.h"
+
+#include <fmt/format.h>
+
+#include <cstring>
+#include <opencv2/imgcodecs.hpp>
+
+#include "rigcal/core/error.h"
+#include "rigcal/core/text.h"
+#include "rigcal/io/files.h"
+#include "rigcal/io/trajectory_io.h"
+
+namespace rigcal::io {
+namespace fs = std::filesystem;
+namespace {
+
+std::string png(const cv::Mat& image) {
+  std::vector<uchar> buffer;
+  if (!cv::imencode(".png", image, buffer)) throw Error("PNG encoding failed");
+  return std::string(buffer.begin(), buffer.end());
+}
+
+std::string frame_name(size_t k, std::string_view ext) { return fmt::format("{:010d}.{}", k, ext); }
+
+std::string corners_csv(const std::vector<std::vector<Eigen::Vector2d>>& corners) {
+  std::string out =
+      "# frame, point, u [px], v [px]: true projections of the target's object points\n";
+  for (size_t k = 0; k < corners.size(); ++k) {
+    for (size_t i = 0; i < corners[k].size(); ++i) {
+      out += fmt::format("{},{},{},{}\n", k, i, format_double(corners[k][i].x()),
+                         format_double(corners[k][i].y()));
+    }
+  }
+  return out;
+}
+
+nlohmann::json pose_json(const SE3& T) {
+  const Eigen::Matrix4d m = T.matrix();
+  nlohmann::json rows = nlohmann::json::array();
+  for (int r = 0; r < 4; ++r) rows.push_back({m(r, 0), m(r, 1), m(r, 2), m(r, 3)});
+  return rows;
+}
+
+void write_camera(const fs::path& dir, const std::vector<Time>& stamps,
+                  const std::vector<cv::Mat>& images,
+                  const std::vector<std::vector<Eigen::Vector2d>>& corners) {
+  std::vector<OutputFile> files{{dir / "timestamps.txt", timestamps_txt(stamps)},
+                                {dir / "corners_truth.csv", corners_csv(corners)}};
+  for (size_t k = 0; k < images.size(); ++k)
+    files.push_back({dir / "data" / frame_name(k, "png"), png(images[k])});
+  write_files_atomic(files);
+}
+
+void write_points(const fs::path& dir, const std::vector<Time>& stamps,
+                  const std::vector<std::vector<sim::LidarPoint>>& scans) {
+  std::vector<OutputFile> files{{dir / "timestamps.txt", timestamps_txt(stamps)}};
+  for (size_t k = 0; k < scans.size(); ++k) {
+    files.push_back({dir / "data" / frame_name(k, "bin"), points_bin(scans[k])});
+    files.push_back({dir / "fields" / frame_name(k, "bin"), fields_bin(scans[k])});
+  }
+  write_files_atomic(files);
+}
+
+}  // namespace
+
+std::string timestamps_txt(const std::vector<Time>& stamps) {
+  std::string out;
+  for (const Time& t : stamps) out += to_iso8601(t) + "\n";
+  return out;
+}
+
+std::string imu_txt(const std::vector<sim::ImuSample>& samples) {
+  std::string out =
+      "linear_acceleration.x,linear_acceleration.y,linear_acceleration.z,angular_velocity.x,"
+      "angular_velocity.y,angular_velocity.z,orientation.w,orientation.x,orientation.y,"
+      "orientation.z";
+  for (const char* c : {"orientation_covariance", "angular_velocity_covariance",
+                        "linear_acceleration_covariance"}) {
+    for (int i = 0; i < 9; ++i) out += fmt::format(",{}[{}]", c, i);
+  }
+  out += "\n";
+  for (const sim::ImuSample& s : samples) {
+    out += fmt::format("{},{},{},{},{},{},1.0,0.0,0.0,0.0,-1.0", format_double(s.accel.x()),
+                       format_double(s.accel.y()), format_double(s.accel.z()),
+                       format_double(s.gyro.x()), format_double(s.gyro.y()),
+                       format_double(s.gyro.z()));
+    for (int i = 0; i < 26; ++i) out += ",0.0";  // 27 covariance entries; the first is -1
+    out += "\n";
+  }
+  return out;
+}
+
+std::string points_bin(const std::vector<sim::LidarPoint>& points) {
+  std::string out(points.size() * 16, '\0');
+  for (size_t i = 0; i < points.size(); ++i) {
+    const float v[4] = {points[i].p.x(), points[i].p.y(), points[i].p.z(), points[i].intensity};
+    std::memcpy(out.data() + 16 * i, v, 16);
+  }
+  return out;
+}
+
+std::string fields_bin(const std::vector<sim::LidarPoint>& points) {
+  std::string out(points.size() * 8, '\0');
+  for (size_t i = 0; i < points.size(); ++i) {
+    const uint32_t t = points[i].t_ns;
+    const uint16_t ring[2] = {points[i].ring, 0};
+    std::memcpy(out.data() + 8 * i, &t, 4);
+    std::memcpy(out.data() + 8 * i + 4, ring, 4);
+  }
+  return out;
+}
+
+void write_stereo(const fs::path& dir, const sim::StereoPart& part, nlohmann::json& truth) {
+  write_camera(dir / "stereo" / "camera_left", part.stamps, part.left, part.corners_left);
+  write_camera(dir / "stereo" / "camera_right", part.stamps, part.right, part.corners_right);
+  nlohmann::json& j = truth["stereo"];
+  j["cameras"] = {part.left_name, part.right_name};
+  j["T_left_board"] = nlohmann::json::array();
+  for (const SE3& T : part.T_left_board) j["T_left_board"].push_back(pose_json(T));
+}
+
+void write_lidar_camera(const fs::path& dir, const sim::LidarCameraPart& part,
+                        nlohmann::json& truth) {
+  const std::string cam_dir = part.camera_name == "cam_l" ? "camera_left" : "camera_right";
+  write_camera(dir / "lidar_camera" / cam_dir, part.stamps, part.images, part.corners);
+  write_points(dir / "lidar_camera" / "ouster_points", part.stamps, part.scans);
+  nlohmann::json& j = truth["lidar_camera"];
+  j["camera"] = part.camera_name;
+  j["T_lidar_board"] = nlohmann::json::array();
+  j["board_points"] = nlohmann::json::array();
+  for (size_t k = 0; k < part.T_lidar_board.size(); ++k) {
+    j["T_lidar_board"].push_back(pose_json(part.T_lidar_board[k]));
+    size_t on_board = 0;
+    for (const sim::LidarPoint& p : part.scans[k]) on_board += p.object == 1;
+    j["board_points"].push_back(on_board);
+  }
+}
+
+void write_imu(const fs::path& dir, const sim::ImuPart& part, nlohmann::json& truth) {
+  std::vector<Time> a, b;
+  for (const sim::ImuSample& s : part.imu) a.push_back(s.stamp);
+  for (const sim::ImuSample& s : part.os_imu) b.push_back(s.stamp);
+  write_files_atomic({{dir / "imu" / "timestamps.txt", timestamps_txt(a)},
+                      {dir / "imu" / "data" / "imu.txt", imu_txt(part.imu)},
+                      {dir / "ouster_imu" / "timestamps.txt", timestamps_txt(b)},
+                      {dir / "ouster_imu" / "data" / "imu.txt", imu_txt(part.os_imu)}});
+  nlohmann::json& j = truth["imu"];
+  j[part.imu_name] = {{"folder", "imu"},
+                      {"time_offset_s", part.imu_offset_s},
+                      {"drift_ppm", part.imu_drift_ppm},
+                      {"samples", part.imu.size()}};
+  j[part.os_imu_name] = {{"folder", "ouster_imu"},
+                         {"time_offset_s", part.os_imu_offset_s},
+                         {"drift_ppm", part.os_imu_drift_ppm},
+                         {"samples", part.os_imu.size()}};
+  j["clock"] = "t_base = t_stamp + time_offset + drift_ppm * 1e-6 * (t_stamp - first stamp)";
+}
+
+void write_trajectories(const fs::path& dir, const sim::TrajectoryPart& part,
+                        nlohmann::json& truth) {
+  write_files_atomic(
+      {{dir / "trajectories" / "truth_lidar.tum", trajectory_to_tum(part.truth_base)},
+       {dir / "trajectories" / "lidar_odometry.tum", trajectory_to_tum(part.odometry)},
+       {dir / "trajectories" / "gnss_ins.tum", trajectory_to_tum(part.gnss)}});
+  nlohmann::json& j = truth["trajectories"];
+  j["gnss_sensor"] = part.gnss_name;
+  j["T_enu_world"] = pose_json(part.T_enu_world);
+  j["gnss_outlier_indices"] = part.gnss_outliers;
+  j["files"] = {{"truth_lidar.tum", "T_world_lidar, the truth, LiDAR rate"},
+                {"lidar_odometry.tum", "T_odom_lidar, drifting odometry"},
+                {"gnss_ins.tum", "T_enu_gnss on the GNSS clock, with noise, outages, outliers"}};
+}
+
+void write_scans(const fs::path& dir, const sim::ScanPart& part, nlohmann::json& truth) {
+  write_points(dir / "scans" / "ouster_points", part.stamps, part.scans);
+  Trajectory t;
+  t.stamps = part.stamps;
+  t.T_world_body = part.T_world_lidar;
+  write_file_atomic(dir / "scans" / "truth_lidar.tum", trajectory_to_tum(t));
+  truth["scans"] = {{"count", part.scans.size()},
+                    {"poses", "scans/truth_lidar.tum: T_world_lidar at each sweep's start"}};
+}
+
+}  // namespace rigcal::io

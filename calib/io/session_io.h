@@ -1,0 +1,36 @@
+#pragma once
+// Writes simulated sessions in the session layout (doc/simulator.md, ../shared/DESIGN.md):
+//   stereo/camera_left|camera_right/{timestamps.txt, data/%010d.png, corners_truth.csv}
+//   lidar_camera/<camera>/..., lidar_camera/ouster_points/{timestamps.txt, data/%010d.bin,
+//   fields/%010d.bin} imu/{timestamps.txt, data/imu.txt}, ouster_imu/{...}
+//   trajectories/{truth_lidar.tum, lidar_odometry.tum, gnss_ins.tum}
+//   scans/ouster_points/{...}, scans/truth_lidar.tum
+//   truth.yaml (the true rig), truth.json (per-item truth)
+// Paths are relative to one output folder; callers write into a temporary folder and rename it.
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "rigcal/sim/session.h"
+
+namespace rigcal::io {
+
+void write_stereo(const std::filesystem::path& dir, const sim::StereoPart& part,
+                  nlohmann::json& truth);
+void write_lidar_camera(const std::filesystem::path& dir, const sim::LidarCameraPart& part,
+                        nlohmann::json& truth);
+void write_imu(const std::filesystem::path& dir, const sim::ImuPart& part, nlohmann::json& truth);
+void write_trajectories(const std::filesystem::path& dir, const sim::TrajectoryPart& part,
+                        nlohmann::json& truth);
+void write_scans(const std::filesystem::path& dir, const sim::ScanPart& part,
+                 nlohmann::json& truth);
+
+// The vbr-devkit IMU layout: timestamps.txt (ISO-8601 a line) and data/imu.txt (a header line,
+// then 37 comma-separated columns: acc xyz, gyro xyz, orientation wxyz, three 3x3 covariances).
+std::string imu_txt(const std::vector<sim::ImuSample>& samples);
+std::string timestamps_txt(const std::vector<Time>& stamps);
+// A scan as KITTI-style float32 x y z intensity, and its fields (uint32 t_ns, uint16 ring, uint16
+// 0).
+std::string points_bin(const std::vector<sim::LidarPoint>& points);
+std::string fields_bin(const std::vector<sim::LidarPoint>& points);
+
+}  // namespace rigcal::io

@@ -1,0 +1,88 @@
+#include "rigcal/io/target_yaml.h"
+
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+
+#include <set>
+
+#include "rigcal/core/error.h"
+#include "rigcal/io/files.h"
+
+namespace rigcal::io {
+
+camera::Target parse_target_yaml(std::string_view text, std::string_view file) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(std::string(text));
+  } catch (const YAML::Exception& e) {
+    fail_at(file, e.mark.is_null() ? 0 : e.mark.line + 1, "",
+            fmt::format("YAML syntax error: {}", e.msg));
+  }
+  if (!root.IsMap()) fail_at(file, 0, "", "expected a map with target_type");
+  auto line = [](const YAML::Node& n) { return n.Mark().is_null() ? 0 : n.Mark().line + 1; };
+  auto get = [&](const char* key) -> YAML::Node {
+    const YAML::Node n = root[key];
+    if (!n) fail_at(file, line(root), key, "missing required key");
+    return n;
+  };
+  auto number = [&](const char* key) {
+    const YAML::Node n = get(key);
+    try {
+      return n.as<double>();
+    } catch (const YAML::Exception&) {
+      fail_at(file, line(n), key, fmt::format("expected a number, got '{}'", n.Scalar()));
+    }
+  };
+  auto integer = [&](const char* key) {
+    const double v = number(key);
+    if (v != std::floor(v)) fail_at(file, line(root[key]), key, "expected a whole number");
+    return static_cast<int>(v);
+  };
+  camera::Target t;
+  const std::string type = get("target_type").as<std::string>();
+  std::set<std::string> known = {"target_type", "name", "margin", "thickness"};
+  if (type == "checkerboard") {
+    t.type = camera::TargetType::checkerboard;
+    t.cols = integer("targetCols");
+    t.rows = integer("targetRows");
+    const double row = number("rowSpacingMeters"), col = number("colSpacingMeters");
+    if (row != col)
+      fail_at(file, line(root["colSpacingMeters"]), "colSpacingMeters",
+              "rigcal needs square checkerboard cells (rowSpacingMeters == colSpacingMeters)");
+    t.square = row;
+    known.insert({"targetCols", "targetRows", "rowSpacingMeters", "colSpacingMeters"});
+  } else if (type == "aprilgrid") {
+    t.type = camera::TargetType::aprilgrid;
+    t.cols = integer("tagCols");
+    t.rows = integer("tagRows");
+    t.tag_size = number("tagSize");
+    t.tag_spacing = number("tagSpacing");
+    known.insert({"tagCols", "tagRows", "tagSize", "tagSpacing", "tagFamily", "codeOffset"});
+  } else {
+    fail_at(file, line(root["target_type"]), "target_type",
+            fmt::format("unknown target type '{}'; expected checkerboard or aprilgrid", type));
+  }
+  for (auto it = root.begin(); it != root.end(); ++it) {
+    if (!known.count(it->first.Scalar())) {
+      fail_at(file, line(it->first), it->first.Scalar(), "unknown key for this target type");
+    }
+  }
+  if (root["name"])
+    t.name = root["name"].as<std::string>();
+  else
+    t.name = std::filesystem::path(std::string(file)).stem().string();
+  if (root["margin"]) t.margin = number("margin");
+  if (root["thickness"]) t.thickness = number("thickness");
+  try {
+    camera::validate(t);
+  } catch (const Error& e) {
+    fail_at(file, 0, "", e.what());
+  }
+  return t;
+}
+
+camera::Target read_target_file(const std::filesystem::path& path) {
+  return parse_target_yaml(read_text_file(path), path.string());
+}
+
+}  // namespace rigcal::io

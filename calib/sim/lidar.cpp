@@ -1,0 +1,135 @@
+#include "rigcal/sim/lidar.h"
+
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+
+namespace rigcal::sim {
+
+void add_box(Scene& scene, const SE3& T, const Eigen::Vector3d& h, double reflectivity, int id) {
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int sign : {-1, 1}) {
+      const int a = (axis + 1) % 3, b = (axis + 2) % 3;
+      Rect r;
+      r.centre = T * (sign * h[axis] * Eigen::Vector3d::Unit(axis));
+      r.u = T.R.col(a);
+      r.v = T.R.col(b);
+      r.half_u = h[a];
+      r.half_v = h[b];
+      r.reflectivity = reflectivity;
+      r.id = id;
+      scene.rects.push_back(r);
+    }
+  }
+}
+
+void add_board(Scene& scene, const camera::Target& target, const camera::Pattern& pattern,
+               const SE3& T_world_board, double z_floor, int id) {
+  const camera::Outline o = camera::outline(target);
+  const Eigen::Vector2d c(0.5 * (o.x_min + o.x_max), 0.5 * (o.y_min + o.y_max));
+  Rect front;
+  front.centre = T_world_board * Eigen::Vector3d(c.x(), c.y(), 0.0);
+  front.u = T_world_board.R.col(0);
+  front.v = T_world_board.R.col(1);
+  front.half_u = 0.5 * o.width();
+  front.half_v = 0.5 * o.height();
+  front.reflectivity = 0.9;
+  front.pattern = &pattern;
+  front.board_origin_uv = c;
+  front.id = id;
+  // The rest of the board: a box of the board's thickness behind the printed face.
+  const double th = std::max(target.thickness, 1e-4);
+  SE3 T_box = T_world_board;
+  T_box.t = T_world_board * Eigen::Vector3d(c.x(), c.y(), 0.5 * th + 1e-5);
+  add_box(scene, T_box, Eigen::Vector3d(0.5 * o.width(), 0.5 * o.height(), 0.5 * th), 0.5, id);
+  scene.rects.push_back(front);  // last: wins ties with the box's front face
+  // A stand: a thin post from the board's lowest point down to the floor, behind the board.
+  double lowest = 1e9;
+  Eigen::Vector3d low_point;
+  for (double x : {o.x_min, o.x_max}) {
+    for (double y : {o.y_min, o.y_max}) {
+      const Eigen::Vector3d p = T_world_board * Eigen::Vector3d(x, y, th);
+      if (p.z() < lowest) lowest = p.z(), low_point = p;
+    }
+  }
+  const Eigen::Vector3d centre_back = T_world_board * Eigen::Vector3d(c.x(), c.y(), th + 0.03);
+  const double height = centre_back.z() - z_floor;
+  if (height > 0.05) {
+    SE3 T_post;
+    T_post.t = Eigen::Vector3d(centre_back.x(), centre_back.y(), z_floor + 0.5 * height);
+    add_box(scene, T_post, Eigen::Vector3d(0.02, 0.02, 0.5 * height), 0.4, 0);
+  }
+}
+
+void add_room(Scene& scene, double hx, double hy, double z_floor, double z_ceiling) {
+  SE3 T;
+  T.t = Eigen::Vector3d(0, 0, 0.5 * (z_floor + z_ceiling));
+  // The inside faces of a big box.
+  add_box(scene, T, Eigen::Vector3d(hx, hy, 0.5 * (z_ceiling - z_floor)), 0.3, 0);
+}
+
+LidarModel os0_128() { return {128, 90.0, 2048, 10.0, 0.01, 0.3, 50.0}; }
+LidarModel os1_64() { return {64, 45.0, 1024, 20.0, 0.01, 0.5, 120.0}; }
+
+std::vector<LidarPoint> sweep(const Scene& scene, const LidarModel& m,
+                              const std::function<SE3(double)>& T_world_lidar, double t0,
+                              std::mt19937_64& rng) {
+  const double period = 1.0 / m.rate_hz;
+  std::vector<std::vector<LidarPoint>> columns(m.columns);
+  std::vector<SE3> poses(m.columns);
+  for (int c = 0; c < m.columns; ++c) poses[c] = T_world_lidar(t0 + period * c / m.columns);
+  tbb::parallel_for(0, m.columns, [&](int c) {
+    const SE3& T = poses[c];
+    // Ouster spins clockwise seen from above: azimuth decreases with the column.
+    const double azimuth = 2.0 * M_PI * (1.0 - static_cast<double>(c) / m.columns);
+    for (int b = 0; b < m.beams; ++b) {
+      const double elevation =
+          (0.5 * m.vertical_fov_deg - m.vertical_fov_deg * b / std::max(1, m.beams - 1)) * M_PI /
+          180.0;
+      const Eigen::Vector3d d_lidar(std::cos(elevation) * std::cos(azimuth),
+                                    std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
+      const Eigen::Vector3d o = T.t, d = T.R * d_lidar;
+      double best = m.max_range_m;
+      const Rect* hit = nullptr;
+      for (const Rect& r : scene.rects) {
+        const Eigen::Vector3d n = r.u.cross(r.v);
+        const double denom = n.dot(d);
+        if (std::abs(denom) < 1e-12) continue;
+        const double s = n.dot(r.centre - o) / denom;
+        if (s < m.min_range_m || s > best) continue;
+        const Eigen::Vector3d q = o + s * d - r.centre;
+        if (std::abs(q.dot(r.u)) > r.half_u || std::abs(q.dot(r.v)) > r.half_v) continue;
+        best = s;
+        hit = &r;
+      }
+      if (!hit) continue;
+      LidarPoint p;
+      p.p = (best * d_lidar).cast<float>();  // noise is added below, in a fixed order
+      p.ring = static_cast<uint16_t>(b);
+      p.t_ns = static_cast<uint32_t>(std::llround(1e9 * period * c / m.columns));
+      p.object = hit->id;
+      const Eigen::Vector3d n = hit->u.cross(hit->v);
+      double albedo = 1.0;
+      if (hit->pattern) {
+        const Eigen::Vector3d q = o + best * d - hit->centre;
+        albedo = 0.1 + 0.9 * hit->pattern->albedo(hit->board_origin_uv.x() + q.dot(hit->u),
+                                                  hit->board_origin_uv.y() + q.dot(hit->v));
+      }
+      p.intensity = static_cast<float>(1000.0 * hit->reflectivity * albedo * std::abs(n.dot(d)));
+      columns[c].push_back(p);
+    }
+  });
+  // Range noise, drawn in a fixed order so that results do not depend on threads.
+  std::normal_distribution<double> N(0.0, m.range_noise_m);
+  std::vector<LidarPoint> out;
+  for (auto& col : columns) {
+    for (LidarPoint& p : col) {
+      const double r = p.p.cast<double>().norm();
+      p.p = (p.p.cast<double>() * ((r + N(rng)) / r)).cast<float>();
+      out.push_back(p);
+    }
+  }
+  return out;
+}
+
+}  // namespace rigcal::sim

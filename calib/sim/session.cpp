@@ -1,0 +1,232 @@
+#include "rigcal/sim/session.h"
+
+#include <fmt/format.h>
+
+#include "rigcal/core/error.h"
+
+namespace rigcal::sim {
+namespace {
+
+const rig::Sensor& camera_named(const rig::Rig& rig, std::string_view name, size_t fallback_index) {
+  if (const rig::Sensor* s = rig::find_sensor(rig, name); s && s->type == rig::SensorType::camera)
+    return *s;
+  const std::vector<const rig::Sensor*> cams = rig::cameras(rig);
+  if (cams.size() <= fallback_index) {
+    throw Error(fmt::format("the rig needs {} camera(s) to simulate this; it has {}",
+                            fallback_index + 1, cams.size()));
+  }
+  return *cams[fallback_index];
+}
+
+const rig::Sensor* imu_named(const rig::Rig& rig, std::string_view name) {
+  const rig::Sensor* s = rig::find_sensor(rig, name);
+  return s && s->type == rig::SensorType::imu ? s : nullptr;
+}
+
+}  // namespace
+
+camera::Target default_target() {
+  camera::Target t;
+  t.name = "a3_checkerboard_8x5_45mm";
+  t.type = camera::TargetType::checkerboard;
+  t.cols = 8;
+  t.rows = 5;
+  t.square = 0.045;
+  t.margin = 0.0075;  // 405 x 270 mm of squares on a 420 x 285 mm board
+  return t;
+}
+
+std::mt19937_64 part_rng(uint64_t seed, std::string_view part) {
+  uint64_t h = 1469598103934665603ULL;  // FNV-1a of the part's name, mixed with the seed
+  for (char c : part) h = (h ^ static_cast<uint8_t>(c)) * 1099511628211ULL;
+  std::seed_seq seq{static_cast<uint32_t>(seed), static_cast<uint32_t>(seed >> 32),
+                    static_cast<uint32_t>(h), static_cast<uint32_t>(h >> 32)};
+  return std::mt19937_64(seq);
+}
+
+StereoPart simulate_stereo(const rig::Rig& rig, const SimConfig& cfg) {
+  std::mt19937_64 rng = part_rng(cfg.seed, "stereo");
+  const rig::Sensor& left = camera_named(rig, "cam_l", 0);
+  const rig::Sensor& right = camera_named(rig, "cam_r", 1);
+  StereoPart part;
+  part.left_name = left.name;
+  part.right_name = right.name;
+  const SE3 T_right_left = rig::T_a_b(rig, right.name, left.name);
+  part.T_left_board =
+      board_poses(left.camera, &right.camera, T_right_left, cfg.target, cfg.boards, rng);
+  const camera::Pattern pattern(cfg.target);
+  const PixelRays rays_l = pixel_rays(left.camera), rays_r = pixel_rays(right.camera);
+  const std::vector<Eigen::Vector3d> points = camera::object_points(cfg.target);
+  for (size_t k = 0; k < part.T_left_board.size(); ++k) {
+    const SE3& T_l = part.T_left_board[k];
+    const SE3 T_r = T_right_left * T_l;
+    part.stamps.push_back(Time::from_seconds(cfg.base_start_s + k * cfg.frame_period_s));
+    part.left.push_back(render_board(rays_l, cfg.target, pattern, T_l, cfg.image, rng));
+    part.right.push_back(render_board(rays_r, cfg.target, pattern, T_r, cfg.image, rng));
+    part.corners_left.push_back(project_points(left.camera, T_l, points));
+    part.corners_right.push_back(project_points(right.camera, T_r, points));
+  }
+  return part;
+}
+
+LidarCameraPart simulate_lidar_camera(const rig::Rig& rig, const SimConfig& cfg) {
+  std::mt19937_64 rng = part_rng(cfg.seed, "lidar-camera");
+  const rig::Sensor& cam = camera_named(rig, cfg.lidar_camera_camera, 1);
+  LidarCameraPart part;
+  part.camera_name = cam.name;
+  const SE3 T_lidar_cam = rig::T_a_b(rig, rig.base_frame, cam.name);
+  BoardPoseConfig boards = cfg.boards;
+  boards.views = cfg.lidar_camera_pairs;
+  boards.min_fill = 0.15;
+  boards.max_fill = 0.45;  // a board on a stand, 1.5 to 4 m away
+  boards.max_tilt_deg = 40;
+  part.T_camera_board = board_poses(cam.camera, nullptr, SE3(), cfg.target, boards, rng);
+  const camera::Pattern pattern(cfg.target);
+  const PixelRays rays = pixel_rays(cam.camera);
+  const double z_floor = -1.3, z_ceiling = 2.2;  // the LiDAR 1.3 m above the floor
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  for (size_t k = 0; k < part.T_camera_board.size(); ++k) {
+    const SE3 T_lidar_board = T_lidar_cam * part.T_camera_board[k];
+    part.T_lidar_board.push_back(T_lidar_board);
+    part.stamps.push_back(Time::from_seconds(cfg.base_start_s + 10.0 * k));
+    part.images.push_back(
+        render_board(rays, cfg.target, pattern, part.T_camera_board[k], cfg.image, rng));
+    part.corners.push_back(
+        project_points(cam.camera, part.T_camera_board[k], camera::object_points(cfg.target)));
+    Scene scene;
+    add_room(scene, 7.0, 5.0, z_floor, z_ceiling);
+    add_board(scene, cfg.target, pattern, T_lidar_board, z_floor, 1);
+    if (cfg.clutter) {
+      // A person-sized box 0.6 to 1 m beside the board, on the floor.
+      const Eigen::Vector3d c = T_lidar_board * Eigen::Vector3d(0.2, 0.15, 0.0);
+      const Eigen::Vector3d side = Eigen::Vector3d(-c.y(), c.x(), 0.0).normalized();
+      SE3 T_person;
+      T_person.t = c + side * (0.8 + 0.2 * U(rng)) * (U(rng) > 0 ? 1 : -1);
+      T_person.t.z() = z_floor + 0.9;
+      T_person.R = Eigen::AngleAxisd(U(rng), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+      add_box(scene, T_person, Eigen::Vector3d(0.25, 0.15, 0.9), 0.4, 2);
+    }
+    part.scans.push_back(sweep(
+        scene, cfg.lidar, [](double) { return SE3(); }, 0.0, rng));
+  }
+  return part;
+}
+
+ImuPart simulate_imu_part(const rig::Rig& rig, const SimConfig& cfg) {
+  std::mt19937_64 rng = part_rng(cfg.seed, "imu");
+  ImuPart part;
+  part.motion = random_motion(cfg.imu_motion, cfg.imu_duration_s + 1.0, rng);
+  const rig::Sensor* imu = imu_named(rig, "imu");
+  const rig::Sensor* os_imu = imu_named(rig, "os_imu");
+  if (!imu || !os_imu)
+    throw Error("simulating IMU streams needs IMU sensors named 'imu' and 'os_imu' in the rig");
+  part.imu_name = imu->name;
+  part.os_imu_name = os_imu->name;
+  ImuSimConfig a = cfg.imu, b = cfg.os_imu;
+  a.time_offset_s = imu->time_offset;  // the truth is the rig's
+  b.time_offset_s = os_imu->time_offset;
+  if (imu->update_rate) a.rate_hz = *imu->update_rate;
+  if (os_imu->update_rate) b.rate_hz = *os_imu->update_rate;
+  part.imu_offset_s = a.time_offset_s;
+  part.os_imu_offset_s = b.time_offset_s;
+  part.imu_drift_ppm = a.drift_ppm;
+  part.os_imu_drift_ppm = b.drift_ppm;
+  const Time start = Time::from_seconds(cfg.base_start_s);
+  part.imu =
+      simulate_imu(part.motion, imu->T_base_sensor, imu->imu, a, start, cfg.imu_duration_s, rng);
+  part.os_imu = simulate_imu(part.motion, os_imu->T_base_sensor, os_imu->imu, b, start,
+                             cfg.imu_duration_s, rng);
+  return part;
+}
+
+TrajectoryPart simulate_trajectories(const rig::Rig& rig, const SimConfig& cfg,
+                                     const Trajectory* replay) {
+  std::mt19937_64 rng = part_rng(cfg.seed, "trajectories");
+  TrajectoryPart part;
+  const rig::Sensor* gnss = rig::find_sensor(rig, "gnss");
+  if (!gnss) gnss = imu_named(rig, "imu");
+  if (!gnss)
+    throw Error("simulating GNSS/INS poses needs a sensor named 'gnss' or 'imu' in the rig");
+  part.gnss_name = gnss->name;
+  Motion motion;
+  PoseSource source;
+  double duration = cfg.trajectory_duration_s;
+  if (replay) {
+    auto [s, d] = pose_source(*replay);
+    source = s;
+    duration = std::min(duration, d);
+  } else {
+    motion = random_motion(cfg.trajectory_motion, duration + 1.0, rng);
+    source = pose_source(motion);
+  }
+  const rig::Sensor& base = rig::sensor(rig, rig.base_frame);
+  const double rate = base.update_rate.value_or(10.0);
+  const Time start = Time::from_seconds(cfg.base_start_s);
+  part.truth_base = sample_poses(source, rate, duration, start);
+  part.odometry = simulate_odometry(part.truth_base, cfg.odometry, rng);
+  part.T_enu_world =
+      SE3::from_rotation_vector(Eigen::Vector3d(0, 0, 0.7), Eigen::Vector3d(120.0, -45.0, 21.0));
+  GnssNoise noise = cfg.gnss;
+  noise.time_offset_s = gnss->time_offset;
+  if (gnss->update_rate) noise.rate_hz = *gnss->update_rate;
+  part.gnss = simulate_gnss(source, duration, start, gnss->T_base_sensor, part.T_enu_world, noise,
+                            rng, &part.gnss_outliers);
+  return part;
+}
+
+ScanPart simulate_scans(const rig::Rig& rig, const SimConfig& cfg) {
+  std::mt19937_64 rng = part_rng(cfg.seed, "scans");
+  ScanPart part;
+  Motion motion = random_motion(MotionKind::car, cfg.scans / cfg.lidar.rate_hz + 2.0, rng);
+  motion.speed = 5.0;
+  prepare(motion, cfg.scans / cfg.lidar.rate_hz + 2.0);
+  // A street world: ground, box buildings on both sides of the path, poles, clutter.
+  Scene scene;
+  SE3 T_ground;
+  T_ground.t = Eigen::Vector3d(0, 0, -1.8 - 0.05);
+  add_box(scene, T_ground, Eigen::Vector3d(400, 400, 0.05), 0.2);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  const double length = motion.speed * (cfg.scans / cfg.lidar.rate_hz + 2.0) + 40.0;
+  for (double s = -20.0; s < length; s += 8.0 + 8.0 * U(rng)) {
+    for (int side : {-1, 1}) {
+      // Along the path's start heading; the path turns slowly, so buildings are placed along it.
+      const SE3 T_path =
+          evaluate(motion, std::clamp(s / motion.speed, 0.0, cfg.scans / cfg.lidar.rate_hz + 1.9))
+              .T_world_base;
+      SE3 T_building;
+      T_building.R = Eigen::AngleAxisd(rotation_vector(T_path.R).z() + 0.2 * (U(rng) - 0.5),
+                                       Eigen::Vector3d::UnitZ())
+                         .toRotationMatrix();
+      const double setback = 9.0 + 6.0 * U(rng);
+      T_building.t = T_path.t + T_building.R * Eigen::Vector3d(0.0, side * setback, 0.0);
+      const Eigen::Vector3d h(3.0 + 3.0 * U(rng), 2.0 + 2.0 * U(rng), 4.0 + 8.0 * U(rng));
+      T_building.t.z() = -1.8 + h.z();
+      T_building.t += T_building.R * Eigen::Vector3d(0.0, side * h.y(), 0.0);
+      add_box(scene, T_building, h, 0.3 + 0.3 * U(rng));
+      if (U(rng) < 0.6) {  // a pole at the kerb
+        SE3 T_pole;
+        T_pole.t = T_path.t + T_building.R * Eigen::Vector3d(2.0 * U(rng), side * 5.0, 0.0);
+        T_pole.t.z() = -1.8 + 3.0;
+        add_box(scene, T_pole, Eigen::Vector3d(0.08, 0.08, 3.0), 0.6);
+      }
+      if (U(rng) < 0.3) {  // clutter: a parked car-sized box
+        SE3 T_car;
+        T_car.R = T_building.R;
+        T_car.t = T_path.t + T_building.R * Eigen::Vector3d(3.0 * U(rng), side * 3.5, 0.0);
+        T_car.t.z() = -1.8 + 0.75;
+        add_box(scene, T_car, Eigen::Vector3d(2.2, 0.9, 0.75), 0.5);
+      }
+    }
+  }
+  const SE3 T_base_lidar = rig::sensor(rig, rig.base_frame).T_base_sensor;
+  auto T_world_lidar = [&](double t) { return evaluate(motion, t).T_world_base * T_base_lidar; };
+  for (int k = 0; k < cfg.scans; ++k) {
+    const double t0 = 1.0 + k / cfg.lidar.rate_hz;
+    part.stamps.push_back(Time::from_seconds(cfg.base_start_s + t0));
+    part.T_world_lidar.push_back(T_world_lidar(t0));
+    part.scans.push_back(sweep(scene, cfg.lidar, T_world_lidar, t0, rng));
+  }
+  return part;
+}
+
+}  // namespace rigcal::sim

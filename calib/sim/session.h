@@ -1,0 +1,101 @@
+#pragma once
+// A complete simulated session for a rig (doc/simulator.md). Each part is computed on its own,
+// from its own random stream (seed, part), so that selecting parts does not change the others
+// and the same seed gives identical output. calib/io/session_io.h writes the parts to disk.
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rigcal/camera/target.h"
+#include "rigcal/core/trajectory.h"
+#include "rigcal/rig/rig.h"
+#include "rigcal/sim/imu.h"
+#include "rigcal/sim/lidar.h"
+#include "rigcal/sim/stereo.h"
+#include "rigcal/sim/trajectories.h"
+
+namespace rigcal::sim {
+
+// The A3 checkerboard rigcal assumes for a VBR-like rig: 8 x 5 inner corners, 45 mm squares
+// (420 x 297 mm sheet). The VBR paper does not give its board's numbers.
+camera::Target default_target();
+
+struct SimConfig {
+  uint64_t seed = 1;
+  double base_start_s = 1000.0;  // the base clock at the start (like vbr-devkit's small bag times)
+  camera::Target target = default_target();
+  // stereo: target images seen by both cameras
+  BoardPoseConfig boards;
+  ImageConfig image;
+  double frame_period_s = 0.5;
+  // lidar-camera: scans and images of the board on a stand in a room
+  int lidar_camera_pairs = 10;
+  std::string lidar_camera_camera = "cam_r";
+  LidarModel lidar = os0_128();
+  bool clutter = true;  // a person-sized box next to the board
+  // imu: two streams of one hand-held motion
+  double imu_duration_s = 120.0;
+  MotionKind imu_motion = MotionKind::handheld;
+  ImuSimConfig imu;     // the external IMU ("imu"); offsets come from the rig's time_offset
+  ImuSimConfig os_imu;  // the LiDAR's IMU ("os_imu")
+  // trajectories
+  double trajectory_duration_s = 300.0;
+  MotionKind trajectory_motion = MotionKind::handheld;
+  std::string replay_tum;  // non-empty: replay this trajectory instead of a generated motion
+  OdometryNoise odometry;
+  GnssNoise gnss;
+  // scans along a trajectory in a street world
+  int scans = 10;
+};
+
+struct StereoPart {
+  std::vector<Time> stamps;
+  std::vector<SE3> T_left_board;
+  std::vector<cv::Mat> left, right;
+  std::vector<std::vector<Eigen::Vector2d>> corners_left, corners_right;  // true pixels
+  std::string left_name, right_name;
+};
+
+struct LidarCameraPart {
+  std::vector<Time> stamps;
+  std::vector<SE3> T_lidar_board, T_camera_board;
+  std::vector<cv::Mat> images;
+  std::vector<std::vector<LidarPoint>> scans;
+  std::vector<std::vector<Eigen::Vector2d>> corners;
+  std::string camera_name;
+};
+
+struct ImuPart {
+  Motion motion;
+  std::vector<ImuSample> imu, os_imu;
+  std::string imu_name, os_imu_name;
+  double imu_offset_s = 0, os_imu_offset_s = 0, imu_drift_ppm = 0, os_imu_drift_ppm = 0;
+};
+
+struct TrajectoryPart {
+  Trajectory truth_base;  // T_world_lidar at the LiDAR rate
+  Trajectory odometry;    // T_odom_lidar
+  Trajectory gnss;        // T_enu_gnss on the GNSS clock
+  std::vector<size_t> gnss_outliers;
+  SE3 T_enu_world;
+  std::string gnss_name;
+};
+
+struct ScanPart {
+  std::vector<Time> stamps;
+  std::vector<SE3> T_world_lidar;  // at the start of each sweep
+  std::vector<std::vector<LidarPoint>> scans;
+};
+
+StereoPart simulate_stereo(const rig::Rig& rig, const SimConfig& config);
+LidarCameraPart simulate_lidar_camera(const rig::Rig& rig, const SimConfig& config);
+ImuPart simulate_imu_part(const rig::Rig& rig, const SimConfig& config);
+TrajectoryPart simulate_trajectories(const rig::Rig& rig, const SimConfig& config,
+                                     const Trajectory* replay = nullptr);
+ScanPart simulate_scans(const rig::Rig& rig, const SimConfig& config);
+
+// The random stream of one part: independent of which other parts run.
+std::mt19937_64 part_rng(uint64_t seed, std::string_view part);
+
+}  // namespace rigcal::sim

@@ -1,0 +1,53 @@
+#pragma once
+// Simulated trajectories for hand-eye and ground truth (doc/simulator.md): the base (LiDAR) frame's
+// true poses, a LiDAR odometry with slow drift, and a GNSS/INS trajectory of another frame on
+// the rig, through the true extrinsic, with RTK noise, outages and multipath outliers.
+#include <functional>
+#include <random>
+#include <utility>
+#include <vector>
+
+#include "rigcal/core/trajectory.h"
+#include "rigcal/sim/motion.h"
+
+namespace rigcal::sim {
+
+// T_world_base at motion time t (s).
+using PoseSource = std::function<SE3(double)>;
+PoseSource pose_source(const Motion& motion);
+// Replays a trajectory (e.g. a VBR ground truth): motion time 0 is its first stamp; poses are
+// interpolated (slerp + linear). The second value is its duration in s.
+std::pair<PoseSource, double> pose_source(const Trajectory& replay);
+
+struct OdometryNoise {
+  double trans_sigma_m = 0.003;  // per step, each axis
+  double rot_sigma_deg = 0.01;   // per step, each axis
+  double scale_error = 0.002;    // relative error of every step's translation
+};
+
+struct GnssNoise {
+  double rate_hz = 100.0;
+  double horizontal_sigma_m = 0.02;  // RTK fixed
+  double vertical_sigma_m = 0.03;
+  double rot_sigma_deg = 0.05;
+  double time_offset_s = 0.0;                      // the GNSS/INS clock: t_base = t_stamp + offset
+  std::vector<std::pair<double, double>> outages;  // [from, to) s with no fixes
+  double outlier_probability = 0.001;              // multipath jumps
+  double outlier_jump_m = 1.5;
+};
+
+// Poses of the base frame every 1/rate s over [0, duration]; stamps base_start + t.
+Trajectory sample_poses(const PoseSource& source, double rate_hz, double duration, Time base_start);
+
+// LiDAR odometry from true base poses: relative motions with noise and scale error, chained from
+// the identity (the odometry frame is the first pose).
+Trajectory simulate_odometry(const Trajectory& truth, const OdometryNoise& noise,
+                             std::mt19937_64& rng);
+
+// GNSS/INS poses of the frame `T_base_gnss` in a local ENU frame (T_enu_world), on the GNSS clock.
+// `outliers` receives the indices of the poses made outliers.
+Trajectory simulate_gnss(const PoseSource& source, double duration, Time base_start,
+                         const SE3& T_base_gnss, const SE3& T_enu_world, const GnssNoise& noise,
+                         std::mt19937_64& rng, std::vector<size_t>* outliers = nullptr);
+
+}  // namespace rigcal::sim
