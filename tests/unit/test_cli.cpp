@@ -221,4 +221,50 @@ TEST_F(Cli, BenchLeaderboardCountsMissingSequencesAsFailed) {
   EXPECT_NE(r.out.find("| 1 | good |"), std::string::npos) << r.out;
 }
 
+TEST_F(Cli, SimulateWritesTheLayoutAndNothingOnFailure) {
+  const fs::path cfg = write("sim.yaml",
+                             "seed: 7\nimu_duration_s: 10\ntrajectories:\n  duration_s: 20\n"
+                             "  gnss: {outages: [[5, 8]]}\nimu: {drift_ppm: 20}\n");
+  const fs::path out = dir_ / "session";
+  CliRun r =
+      run("simulate --out " + out.string() + " --what imu,trajectories --config " + cfg.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* f : {"truth.yaml", "truth.json", "imu/timestamps.txt", "imu/data/imu.txt",
+                        "ouster_imu/data/imu.txt", "trajectories/truth_lidar.tum",
+                        "trajectories/lidar_odometry.tum", "trajectories/gnss_ins.tum"}) {
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+  }
+  EXPECT_EQ(run("rig validate " + (out / "truth.yaml").string()).status, 0);
+  const nlohmann::json truth = nlohmann::json::parse(slurp(out / "truth.json"));
+  EXPECT_EQ(truth["seed"], 7);
+  EXPECT_EQ(truth["imu"]["imu"]["drift_ppm"], 20.0);
+  // 37 columns a line in imu.txt, and as many lines as stamps.
+  const std::string imu = slurp(out / "imu" / "data" / "imu.txt");
+  const std::string second_line =
+      imu.substr(imu.find('\n') + 1, imu.find('\n', imu.find('\n') + 1) - imu.find('\n') - 1);
+  EXPECT_EQ(std::count(second_line.begin(), second_line.end(), ','), 36);
+  // The odometry scores against the truth with the benchmark.
+  r = run("bench --gt " + (out / "trajectories" / "truth_lidar.tum").string() + " --est " +
+          (out / "trajectories" / "lidar_odometry.tum").string());
+  EXPECT_EQ(r.status, 0) << r.err;
+
+  // A non-empty folder is refused; bad parts and bad keys write nothing.
+  r = run("simulate --out " + out.string() + " --what imu");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("exists and is not empty"), std::string::npos);
+  r = run("simulate --out " + (dir_ / "x").string() + " --what imu,video");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("unknown part 'video'"), std::string::npos);
+  const fs::path bad = write("bad.yaml", "seed: 1\nstereo:\n  viewz: 3\n");
+  r = run("simulate --out " + (dir_ / "y").string() + " --config " + bad.string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.err, "rigcal: error: " + bad.string() +
+                       ":3: key 'stereo.viewz': unknown key (doc/simulator.md lists the keys)\n");
+  for (const auto& e : fs::directory_iterator(dir_)) {
+    EXPECT_EQ(e.path().filename().string().find(".partial"), std::string::npos) << e.path();
+    EXPECT_NE(e.path().filename(), "x");
+    EXPECT_NE(e.path().filename(), "y");
+  }
+}
+
 }  // namespace
