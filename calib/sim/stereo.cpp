@@ -51,11 +51,13 @@ std::vector<SE3> board_poses(const rig::CameraModel& left, const rig::CameraMode
   for (int view = 0; view < cfg.views; ++view) {
     const int cell = view % 9;
     bool found = false;
+    // The fill is drawn once and shrunk by 5 % every 50 failed placements, so that views keep
+    // the largest fill that fits (both cameras seeing the whole board bounds it for a stereo pair).
+    double fill = cfg.min_fill + (cfg.max_fill - cfg.min_fill) * u01(rng);
     for (int attempt = 0; attempt < 4000 && !found; ++attempt) {
+      if (attempt > 0 && attempt % 50 == 0) fill = std::max(0.5 * cfg.min_fill, 0.95 * fill);
       // Relax the cell after many failures (a large board may not fit in a corner).
       const bool relax = attempt > 2000;
-      const double fill =
-          cfg.min_fill + (cfg.max_fill - cfg.min_fill) * u01(rng) * (relax ? 0.5 : 1.0);
       const double distance = left.fx * extent / (fill * left.width);
       const double cu = ((relax ? 3 * u01(rng) : cell % 3 + u01(rng)) / 3.0) * left.width;
       const double cv = ((relax ? 3 * u01(rng) : cell / 3 + u01(rng)) / 3.0) * left.height;
