@@ -36,3 +36,11 @@ echo
   --association nearest | tail -n 3
 echo
 echo "Benchmark report (bench.json, trajectory_top.svg, ate_along.svg) in $out/bench"
+
+echo
+echo "== simulated session of the sample rig (truth in $out/sim/truth.yaml and truth.json)"
+printf "stereo:\n  views: 6\nscans:\n  count: 3\nlidar_camera:\n  pairs: 3\n" > "$out/sim.yaml"
+"$rigcal" simulate --out "$out/sim" --config "$out/sim.yaml"
+echo
+"$rigcal" bench --gt "$out/sim/trajectories/truth_lidar.tum" \
+  --est "$out/sim/trajectories/lidar_odometry.tum" | sed -n '1,8p'

@@ -248,6 +248,17 @@ TEST_F(Cli, SimulateWritesTheLayoutAndNothingOnFailure) {
           (out / "trajectories" / "lidar_odometry.tum").string());
   EXPECT_EQ(r.status, 0) << r.err;
 
+  // The same seed gives byte-identical files.
+  const fs::path again = dir_ / "again";
+  ASSERT_EQ(
+      run("simulate --out " + again.string() + " --what imu,trajectories --config " + cfg.string())
+          .status,
+      0);
+  for (const char* f :
+       {"imu/data/imu.txt", "ouster_imu/timestamps.txt", "trajectories/gnss_ins.tum",
+        "trajectories/lidar_odometry.tum", "truth.json", "truth.yaml"}) {
+    EXPECT_EQ(slurp(out / f), slurp(again / f)) << f;
+  }
   // A non-empty folder is refused; bad parts and bad keys write nothing.
   r = run("simulate --out " + out.string() + " --what imu");
   EXPECT_EQ(r.status, 2);
