@@ -1,0 +1,403 @@
+#include "rigcal/camera/calibrate.h"
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+#include <fmt/format.h>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+
+#include "rigcal/core/error.h"
+
+namespace rigcal::camera {
+namespace {
+
+// Projection with the intrinsics block k = [fx fy cx cy d...] (radtan: k1 k2 p1 p2 [k3];
+// equidistant: k1..k4), OpenCV's formulas (calib/camera/lens.h).
+template <typename T>
+void project(const T* k, bool radtan, int n_coeffs, const T* p, T* uv) {
+  const T x = p[0] / p[2], y = p[1] / p[2];
+  const T r2 = x * x + y * y;
+  T xd, yd;
+  if (radtan) {
+    const T k3 = n_coeffs > 4 ? k[8] : T(0.0);
+    const T radial = T(1.0) + r2 * (k[4] + r2 * (k[5] + r2 * k3));
+    xd = x * radial + T(2.0) * k[6] * x * y + k[7] * (r2 + T(2.0) * x * x);
+    yd = y * radial + k[6] * (r2 + T(2.0) * y * y) + T(2.0) * k[7] * x * y;
+  } else if (r2 < T(1e-16)) {
+    xd = x;
+    yd = y;
+  } else {
+    using std::atan;
+    using std::sqrt;
+    const T r = sqrt(r2);
+    const T th = atan(r), t2 = th * th;
+    const T thd = th * (T(1.0) + t2 * (k[4] + t2 * (k[5] + t2 * (k[6] + t2 * k[7]))));
+    xd = x * thd / r;
+    yd = y * thd / r;
+  }
+  uv[0] = k[0] * xd + k[2];
+  uv[1] = k[1] * yd + k[3];
+}
+
+// A corner seen by camera 0: intrinsics, board rotation and translation in camera 0.
+template <int NK>
+struct Cam0Error {
+  Eigen::Vector3d p_board;
+  Eigen::Vector2d observed;
+  bool radtan;
+  template <typename T>
+  bool operator()(const T* k, const T* q_board, const T* t_board, T* r) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q(q_board);
+    const Eigen::Matrix<T, 3, 1> p =
+        q * p_board.cast<T>() + Eigen::Map<const Eigen::Matrix<T, 3, 1>>(t_board);
+    T uv[2];
+    project(k, radtan, NK - 4, p.data(), uv);
+    r[0] = uv[0] - T(observed.x());
+    r[1] = uv[1] - T(observed.y());
+    return true;
+  }
+};
+
+// A corner seen by camera c: also T_c_0.
+template <int NK>
+struct CamCError {
+  Eigen::Vector3d p_board;
+  Eigen::Vector2d observed;
+  bool radtan;
+  template <typename T>
+  bool operator()(const T* k, const T* q_board, const T* t_board, const T* q_c0, const T* t_c0,
+                  T* r) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> qb(q_board), qc(q_c0);
+    const Eigen::Matrix<T, 3, 1> p0 =
+        qb * p_board.cast<T>() + Eigen::Map<const Eigen::Matrix<T, 3, 1>>(t_board);
+    const Eigen::Matrix<T, 3, 1> p = qc * p0 + Eigen::Map<const Eigen::Matrix<T, 3, 1>>(t_c0);
+    T uv[2];
+    project(k, radtan, NK - 4, p.data(), uv);
+    r[0] = uv[0] - T(observed.x());
+    r[1] = uv[1] - T(observed.y());
+    return true;
+  }
+};
+
+template <int NK>
+ceres::CostFunction* make_cost(int camera, const Eigen::Vector3d& p, const Eigen::Vector2d& uv,
+                               bool radtan) {
+  if (camera == 0)
+    return new ceres::AutoDiffCostFunction<Cam0Error<NK>, 2, NK, 4, 3>(
+        new Cam0Error<NK>{p, uv, radtan});
+  return new ceres::AutoDiffCostFunction<CamCError<NK>, 2, NK, 4, 3, 4, 3>(
+      new CamCError<NK>{p, uv, radtan});
+}
+
+struct Pose {
+  Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d t = Eigen::Vector3d::Zero();
+  SE3 se3() const { return SE3::from_quaternion(q, t); }
+  static Pose from(const SE3& T) { return {T.quaternion(), T.t}; }
+};
+
+SE3 from_rvec_tvec(const cv::Mat& rvec, const cv::Mat& tvec) {
+  cv::Mat R;
+  cv::Rodrigues(rvec, R);
+  SE3 T;
+  cv::cv2eigen(R, T.R);
+  cv::Vec3d t(tvec);
+  T.t = Eigen::Vector3d(t[0], t[1], t[2]);
+  return T;
+}
+
+double mad_sigma(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  for (double& x : v) x = std::abs(x);
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return 1.4826 * v[v.size() / 2];
+}
+
+}  // namespace
+
+std::vector<double> intrinsics_vector(const rig::CameraModel& m) {
+  std::vector<double> k = {m.fx, m.fy, m.cx, m.cy};
+  k.insert(k.end(), m.distortion_coeffs.begin(), m.distortion_coeffs.end());
+  return k;
+}
+
+CalibrationResult calibrate(const Target& target, const std::vector<CameraInput>& cams,
+                            const CalibrationOptions& opt) {
+  if (cams.empty()) throw Error("no camera to calibrate");
+  const size_t n_frames = cams[0].frames.size();
+  for (const CameraInput& c : cams) {
+    if (c.frames.size() != n_frames) {
+      throw Error(fmt::format("camera {} has {} frames, camera {} has {}: frames must pair up",
+                              c.name, c.frames.size(), cams[0].name, n_frames));
+    }
+  }
+  const bool radtan = opt.model == rig::DistortionModel::radtan;
+  const int n_coeffs = radtan ? opt.radtan_coefficients : 4;
+  if (radtan && n_coeffs != 4 && n_coeffs != 5) throw Error("radtan takes 4 or 5 coefficients");
+  const int NK = 4 + n_coeffs;
+  const std::vector<Eigen::Vector3d> object = object_points(target);
+
+  // ---- initialization, per camera: OpenCV's calibration gives intrinsics and board poses ----
+  std::vector<std::vector<double>> intr(cams.size());
+  std::vector<std::vector<std::optional<SE3>>> T_c_board(cams.size(),
+                                                         std::vector<std::optional<SE3>>(n_frames));
+  for (size_t c = 0; c < cams.size(); ++c) {
+    std::vector<std::vector<cv::Point3f>> obj;
+    std::vector<std::vector<cv::Point2f>> img;
+    std::vector<size_t> frame_of;
+    for (size_t f = 0; f < n_frames; ++f) {
+      const Detection& d = cams[c].frames[f];
+      if (!d.found || d.pixels.size() < 6) continue;
+      obj.emplace_back();
+      img.emplace_back();
+      for (size_t i = 0; i < d.pixels.size(); ++i) {
+        const Eigen::Vector3d& p = object[d.point_ids[i]];
+        obj.back().emplace_back(p.x(), p.y(), p.z());
+        img.back().emplace_back(d.pixels[i].x(), d.pixels[i].y());
+      }
+      frame_of.push_back(f);
+    }
+    if (static_cast<int>(obj.size()) < opt.min_views) {
+      throw Error(fmt::format("camera {}: {} usable views of the target; at least {} are needed",
+                              cams[c].name, obj.size(), opt.min_views));
+    }
+    const cv::Size size(cams[c].width, cams[c].height);
+    cv::Mat K = cv::Mat::eye(3, 3, CV_64F), D;
+    std::vector<cv::Mat> rvecs, tvecs;
+    // Pinhole with radial k1 k2 (no tangential, no k3) is a safe start for both models: Ceres
+    // then frees every coefficient. No interactive guesses, no NaN seeds.
+    const int flags = cv::CALIB_ZERO_TANGENT_DIST | cv::CALIB_FIX_K3;
+    cv::calibrateCamera(
+        obj, img, size, K, D, rvecs, tvecs, flags,
+        cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, 1e-9));
+    std::vector<double> k = {K.at<double>(0, 0), K.at<double>(1, 1), K.at<double>(0, 2),
+                             K.at<double>(1, 2)};
+    if (radtan) {
+      k.insert(k.end(), {D.at<double>(0), D.at<double>(1), 0.0, 0.0});
+      if (n_coeffs == 5) k.push_back(0.0);
+    } else {
+      k.insert(k.end(), {0.0, 0.0, 0.0, 0.0});
+    }
+    for (double v : k) {
+      if (!std::isfinite(v))
+        throw Error(fmt::format("camera {}: the initial calibration diverged", cams[c].name));
+    }
+    intr[c] = k;
+    for (size_t i = 0; i < frame_of.size(); ++i)
+      T_c_board[c][frame_of[i]] = from_rvec_tvec(rvecs[i], tvecs[i]);
+  }
+  // Other cameras in camera 0: the average over shared frames.
+  std::vector<Pose> cam_pose(cams.size());
+  for (size_t c = 1; c < cams.size(); ++c) {
+    Eigen::Vector4d q_sum = Eigen::Vector4d::Zero();
+    std::vector<double> tx, ty, tz;
+    Eigen::Quaterniond q_ref = Eigen::Quaterniond::Identity();
+    for (size_t f = 0; f < n_frames; ++f) {
+      if (!T_c_board[0][f] || !T_c_board[c][f]) continue;
+      const SE3 T = *T_c_board[c][f] * T_c_board[0][f]->inverse();
+      Eigen::Quaterniond q = T.quaternion();
+      if (tx.empty()) q_ref = q;
+      if (q.coeffs().dot(q_ref.coeffs()) < 0) q.coeffs() *= -1;
+      q_sum += q.coeffs();
+      tx.push_back(T.t.x()), ty.push_back(T.t.y()), tz.push_back(T.t.z());
+    }
+    if (tx.empty())
+      throw Error(
+          fmt::format("cameras {} and {} never see the target in the same frame: their relative "
+                      "pose is unknown",
+                      cams[0].name, cams[c].name));
+    auto med = [](std::vector<double> v) {
+      std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+      return v[v.size() / 2];
+    };
+    cam_pose[c].q.coeffs() = q_sum.normalized();  // the normalized mean of aligned quaternions
+    cam_pose[c].t = Eigen::Vector3d(med(tx), med(ty), med(tz));
+  }
+  std::vector<std::optional<Pose>> board(n_frames);
+  for (size_t f = 0; f < n_frames; ++f) {
+    if (T_c_board[0][f]) {
+      board[f] = Pose::from(*T_c_board[0][f]);
+      continue;
+    }
+    for (size_t c = 1; c < cams.size(); ++c) {
+      if (T_c_board[c][f]) {
+        board[f] = Pose::from(cam_pose[c].se3().inverse() * *T_c_board[c][f]);
+        break;
+      }
+    }
+  }
+
+  // ---- the joint problem, with outlier rejection ----
+  CalibrationResult res;
+  for (size_t c = 0; c < cams.size(); ++c) {
+    for (size_t f = 0; f < n_frames; ++f) {
+      const Detection& d = cams[c].frames[f];
+      if (!d.found || !board[f]) continue;
+      for (size_t i = 0; i < d.pixels.size(); ++i) {
+        CornerResidual cr;
+        cr.camera = static_cast<int>(c);
+        cr.frame = static_cast<int>(f);
+        cr.point = d.point_ids[i];
+        cr.observed = d.pixels[i];
+        res.residuals.push_back(cr);
+      }
+    }
+  }
+  auto solve = [&](bool robust, ceres::Problem* out_problem) {
+    ceres::Problem::Options po;
+    ceres::Problem local(po);
+    ceres::Problem& problem = out_problem ? *out_problem : local;
+    for (const CornerResidual& cr : res.residuals) {
+      if (cr.outlier) continue;
+      const Eigen::Vector3d& p = object[cr.point];
+      ceres::CostFunction* cost = NK == 8 ? make_cost<8>(cr.camera, p, cr.observed, radtan)
+                                          : make_cost<9>(cr.camera, p, cr.observed, radtan);
+      ceres::LossFunction* loss = robust ? new ceres::HuberLoss(opt.huber_px) : nullptr;
+      Pose& b = *board[cr.frame];
+      if (cr.camera == 0) {
+        problem.AddResidualBlock(cost, loss, intr[0].data(), b.q.coeffs().data(), b.t.data());
+      } else {
+        Pose& cp = cam_pose[cr.camera];
+        problem.AddResidualBlock(cost, loss, intr[cr.camera].data(), b.q.coeffs().data(),
+                                 b.t.data(), cp.q.coeffs().data(), cp.t.data());
+      }
+    }
+    for (auto& b : board) {
+      if (b && problem.HasParameterBlock(b->q.coeffs().data())) {
+        problem.SetManifold(b->q.coeffs().data(), new ceres::EigenQuaternionManifold);
+      }
+    }
+    for (size_t c = 1; c < cams.size(); ++c) {
+      if (problem.HasParameterBlock(cam_pose[c].q.coeffs().data())) {
+        problem.SetManifold(cam_pose[c].q.coeffs().data(), new ceres::EigenQuaternionManifold);
+      }
+    }
+    ceres::Solver::Options so;
+    so.linear_solver_type = ceres::SPARSE_SCHUR;
+    so.max_num_iterations = 200;
+    so.function_tolerance = 1e-12;
+    so.parameter_tolerance = 1e-12;
+    so.num_threads = 2;
+    ceres::Solver::Summary summary;
+    ceres::Solve(so, &problem, &summary);
+    if (!summary.IsSolutionUsable())
+      throw Error("the calibration solve failed: " + summary.BriefReport());
+  };
+  auto update_residuals = [&] {
+    for (CornerResidual& cr : res.residuals) {
+      const Pose& b = *board[cr.frame];
+      Eigen::Vector3d p = b.q * object[cr.point] + b.t;
+      if (cr.camera > 0) p = cam_pose[cr.camera].q * p + cam_pose[cr.camera].t;
+      Eigen::Vector2d uv;
+      project(intr[cr.camera].data(), radtan, n_coeffs, p.data(), uv.data());
+      cr.residual = uv - cr.observed;
+    }
+  };
+  for (int round = 0; round < opt.max_rejection_rounds; ++round) {
+    solve(true, nullptr);
+    update_residuals();
+    std::vector<double> coords;
+    for (const CornerResidual& cr : res.residuals) {
+      if (!cr.outlier) coords.push_back(cr.residual.x()), coords.push_back(cr.residual.y());
+    }
+    const double sigma = mad_sigma(coords);
+    size_t dropped = 0;
+    for (CornerResidual& cr : res.residuals) {
+      if (!cr.outlier && cr.residual.cwiseAbs().maxCoeff() > opt.outlier_k_sigma * sigma)
+        cr.outlier = true, ++dropped;
+    }
+    if (dropped == 0) break;
+  }
+  // Final: plain least squares on the inliers, kept for the covariance.
+  ceres::Problem problem;
+  solve(false, &problem);
+  update_residuals();
+
+  double sse = 0.0;
+  size_t n_in = 0;
+  for (const CornerResidual& cr : res.residuals) {
+    if (cr.outlier) {
+      ++res.n_outliers;
+      continue;
+    }
+    sse += cr.residual.squaredNorm();
+    ++n_in;
+  }
+  res.rms_2d_px = std::sqrt(sse / n_in);
+  res.rms_coord_px = std::sqrt(sse / (2.0 * n_in));
+  res.n_residuals = 2 * n_in;
+  res.n_parameters = cams.size() * NK + 6 * (cams.size() - 1);
+  for (const auto& b : board) res.n_parameters += b ? 6 : 0;
+  const double dof = static_cast<double>(res.n_residuals) - static_cast<double>(res.n_parameters);
+  res.noise_sigma_px = std::sqrt(sse / std::max(1.0, dof));
+
+  // Covariance of intrinsics and camera poses, scaled by the estimated noise.
+  std::vector<const double*> blocks;
+  for (size_t c = 0; c < cams.size(); ++c) blocks.push_back(intr[c].data());
+  for (size_t c = 1; c < cams.size(); ++c) {
+    blocks.push_back(cam_pose[c].q.coeffs().data());
+    blocks.push_back(cam_pose[c].t.data());
+  }
+  ceres::Covariance::Options co;
+  co.algorithm_type = ceres::DENSE_SVD;
+  co.null_space_rank = -1;
+  ceres::Covariance covariance(co);
+  const int n_cov = static_cast<int>(cams.size()) * NK + 6 * (static_cast<int>(cams.size()) - 1);
+  res.covariance = Eigen::MatrixXd::Zero(n_cov, n_cov);
+  bool have_cov = false;
+  if (covariance.Compute(blocks, &problem)) {
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> cov(n_cov, n_cov);
+    have_cov = covariance.GetCovarianceMatrixInTangentSpace(blocks, cov.data());
+    res.covariance = cov * (res.noise_sigma_px * res.noise_sigma_px);
+  }
+  if (!have_cov)
+    res.notes.push_back(
+        "the covariance could not be computed (rank-deficient problem): the data do not determine "
+        "every parameter");
+
+  for (size_t c = 0; c < cams.size(); ++c) {
+    CameraResult cr;
+    rig::CameraModel& m = cr.model;
+    m.fx = intr[c][0], m.fy = intr[c][1], m.cx = intr[c][2], m.cy = intr[c][3];
+    m.distortion_model = opt.model;
+    m.distortion_coeffs.assign(intr[c].begin() + 4, intr[c].end());
+    m.width = cams[c].width;
+    m.height = cams[c].height;
+    for (int i = 0; i < NK; ++i)
+      cr.stddev.push_back(std::sqrt(std::max(0.0, res.covariance(c * NK + i, c * NK + i))));
+    std::vector<double> sse_f(n_frames, 0.0);
+    std::vector<int> n_f(n_frames, 0);
+    for (const CornerResidual& r : res.residuals) {
+      if (r.camera != static_cast<int>(c) || r.outlier) continue;
+      sse_f[r.frame] += r.residual.squaredNorm();
+      ++n_f[r.frame];
+      ++cr.n_corners;
+    }
+    for (size_t f = 0; f < n_frames; ++f) {
+      cr.view_rms.push_back(n_f[f] ? std::sqrt(sse_f[f] / n_f[f]) : NAN);
+      cr.n_views += n_f[f] > 0;
+    }
+    res.cameras.push_back(cr);
+    res.T_cam_cam0.push_back(c == 0 ? SE3() : cam_pose[c].se3());
+    if (c == 0) {
+      res.rotation_stddev_deg.emplace_back(0, 0, 0);
+      res.translation_stddev_m.emplace_back(0, 0, 0);
+    } else {
+      const int base = static_cast<int>(cams.size()) * NK + 6 * (static_cast<int>(c) - 1);
+      Eigen::Vector3d r, t;
+      for (int i = 0; i < 3; ++i) {
+        // Ceres' quaternion tangent: q + d = [cos|d|, sin|d| d/|d|] q, a rotation of 2|d|.
+        r[i] = 2.0 * std::sqrt(std::max(0.0, res.covariance(base + i, base + i))) * 180.0 / M_PI;
+        t[i] = std::sqrt(std::max(0.0, res.covariance(base + 3 + i, base + 3 + i)));
+      }
+      res.rotation_stddev_deg.push_back(r);
+      res.translation_stddev_m.push_back(t);
+    }
+  }
+  for (const auto& b : board)
+    res.T_cam0_board.push_back(b ? std::optional<SE3>(b->se3()) : std::nullopt);
+  return res;
+}
+
+}  // namespace rigcal::camera

@@ -1,0 +1,32 @@
+#pragma once
+// Target detection in one image (doc/cameras.md). Checkerboards: OpenCV's sector-based detector
+// on a downscaled probe (bounded time; no minutes-long search on images without a board), then
+// cornerSubPix at full resolution with a window derived from the observed square size, and the
+// corner order fixed so that point 0 is the target's origin corner. AprilGrids: OpenCV's aruco
+// (DICT_APRILTAG_36h11, 2-bit border), every tag's four corners numbered as Kalibr numbers them,
+// refined the same way; partial boards allowed, ids checked.
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "rigcal/camera/target.h"
+
+namespace rigcal::camera {
+
+struct Detection {
+  bool found = false;
+  std::vector<int> point_ids;           // indices into object_points(target)
+  std::vector<Eigen::Vector2d> pixels;  // refined corners, px
+  std::string note;                     // why nothing was found, or what was dropped
+  double square_px = 0;                 // median observed square (or tag cell) size, px
+};
+
+struct DetectOptions {
+  int probe_max_size = 800;  // the probe image's larger side, px
+  int min_tags = 4;          // AprilGrid: fewer decoded tags count as no detection
+};
+
+// `gray`: 8-bit single channel. Never throws for an image without a target (found = false).
+Detection detect(const cv::Mat& gray, const Target& target, const DetectOptions& options = {});
+
+}  // namespace rigcal::camera
