@@ -13,5 +13,7 @@ void add_rig_convert(CLI::App& rig);
 void add_bench(CLI::App& app);
 // `rigcal simulate`
 void add_simulate(CLI::App& app);
+// `rigcal cameras`
+void add_cameras(CLI::App& app);
 
 }  // namespace rigcal::cli

@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   rigcal::cli::add_rig_convert(*rig);
   rigcal::cli::add_bench(app);
   rigcal::cli::add_simulate(app);
+  rigcal::cli::add_cameras(app);
 
   try {
     app.parse(argc, argv);
