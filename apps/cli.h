@@ -15,5 +15,7 @@ void add_bench(CLI::App& app);
 void add_simulate(CLI::App& app);
 // `rigcal cameras`
 void add_cameras(CLI::App& app);
+// `rigcal target print`
+void add_target_print(CLI::App& target);
 
 }  // namespace rigcal::cli

@@ -27,6 +27,9 @@ int main(int argc, char** argv) {
   rigcal::cli::add_bench(app);
   rigcal::cli::add_simulate(app);
   rigcal::cli::add_cameras(app);
+  CLI::App* target = app.add_subcommand("target", "Calibration targets: printable PDFs");
+  target->require_subcommand(1);
+  rigcal::cli::add_target_print(*target);
 
   try {
     app.parse(argc, argv);

@@ -5,10 +5,14 @@
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
 
 #include "fixtures.h"
 #include "rigcal/camera/calibrate.h"
 #include "rigcal/core/error.h"
+#include "rigcal/io/target_pdf.h"
 #include "rigcal/io/target_yaml.h"
 #include "rigcal/rig/rig_yaml.h"
 #include "rigcal/sim/session.h"
@@ -186,6 +190,49 @@ TEST(CameraInputErrors, ClearMessages) {
   cams.push_back(cams[0]);
   cams[1].frames.resize(3);
   EXPECT_THROW(calibrate(target, cams), Error);
+}
+
+}  // namespace
+}  // namespace rigcal::camera
+
+namespace rigcal::camera {
+namespace {
+
+// `rigcal target print`: the PDF rendered back to pixels by poppler detects as the target, at the
+// printed scale.
+TEST(TargetPdf, RendersBackToTheTargetAtExactScale) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("rigcal_pdf_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  for (const char* name : {"a3_checkerboard_8x5_45mm", "aprilgrid_6x6_88mm"}) {
+    SCOPED_TRACE(name);
+    const Target t = io::read_target_file(std::string(RIGCAL_SOURCE_DIR "/targets/") + name + ".yaml");
+    const std::string pdf = io::target_pdf(t);
+    ASSERT_EQ(pdf.substr(0, 5), "%PDF-");
+    std::ofstream((dir / "t.pdf").string(), std::ios::binary) << pdf;
+    const int dpi = 72;
+    ASSERT_EQ(std::system(fmt::format("pdftoppm -r {} -gray -png -singlefile {} {}", dpi, (dir / "t.pdf").string(),
+                                      (dir / "t").string()).c_str()), 0) << "pdftoppm (poppler-utils) is needed";
+    const cv::Mat img = cv::imread((dir / "t.png").string(), cv::IMREAD_GRAYSCALE);
+    ASSERT_FALSE(img.empty());
+    const Detection d = detect(img, t);
+    ASSERT_TRUE(d.found) << d.note;
+    EXPECT_EQ(d.pixels.size(), object_points(t).size());  // every corner, every tag
+    // Scale: the distance between points 0 and 1 is one square (checkerboard) or one tag side.
+    const double expected_px = (t.type == TargetType::checkerboard ? t.square : t.tag_size) * dpi / 0.0254;
+    size_t i0 = 0, i1 = 0;
+    for (size_t k = 0; k < d.point_ids.size(); ++k) {
+      if (d.point_ids[k] == 0) i0 = k;
+      if (d.point_ids[k] == 1) i1 = k;
+    }
+    EXPECT_NEAR((d.pixels[i1] - d.pixels[i0]).norm(), expected_px, 0.01 * expected_px);
+    // Point 0 of a checkerboard (rows down the page) is top left; of an AprilGrid, bottom left.
+    if (t.type == TargetType::checkerboard) {
+      EXPECT_LT(d.pixels[i0].y(), d.pixels.back().y());
+    } else {
+      EXPECT_GT(d.pixels[i0].y(), img.rows / 2);
+    }
+  }
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
