@@ -2,16 +2,17 @@
 // same corners, and against simulator truth for both lens models.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
-#include <opencv2/calib3d.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <filesystem>
 #include <fstream>
-#include <unistd.h>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "fixtures.h"
 #include "rigcal/camera/calibrate.h"
 #include "rigcal/core/error.h"
+#include "rigcal/io/camera_report.h"
 #include "rigcal/io/target_pdf.h"
 #include "rigcal/io/target_yaml.h"
 #include "rigcal/rig/rig_yaml.h"
@@ -201,24 +202,30 @@ namespace {
 // `rigcal target print`: the PDF rendered back to pixels by poppler detects as the target, at the
 // printed scale.
 TEST(TargetPdf, RendersBackToTheTargetAtExactScale) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("rigcal_pdf_" + std::to_string(::getpid()));
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("rigcal_pdf_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   for (const char* name : {"a3_checkerboard_8x5_45mm", "aprilgrid_6x6_88mm"}) {
     SCOPED_TRACE(name);
-    const Target t = io::read_target_file(std::string(RIGCAL_SOURCE_DIR "/targets/") + name + ".yaml");
+    const Target t =
+        io::read_target_file(std::string(RIGCAL_SOURCE_DIR "/targets/") + name + ".yaml");
     const std::string pdf = io::target_pdf(t);
     ASSERT_EQ(pdf.substr(0, 5), "%PDF-");
     std::ofstream((dir / "t.pdf").string(), std::ios::binary) << pdf;
     const int dpi = 72;
-    ASSERT_EQ(std::system(fmt::format("pdftoppm -r {} -gray -png -singlefile {} {}", dpi, (dir / "t.pdf").string(),
-                                      (dir / "t").string()).c_str()), 0) << "pdftoppm (poppler-utils) is needed";
+    ASSERT_EQ(std::system(fmt::format("pdftoppm -r {} -gray -png -singlefile {} {}", dpi,
+                                      (dir / "t.pdf").string(), (dir / "t").string())
+                              .c_str()),
+              0)
+        << "pdftoppm (poppler-utils) is needed";
     const cv::Mat img = cv::imread((dir / "t.png").string(), cv::IMREAD_GRAYSCALE);
     ASSERT_FALSE(img.empty());
     const Detection d = detect(img, t);
     ASSERT_TRUE(d.found) << d.note;
     EXPECT_EQ(d.pixels.size(), object_points(t).size());  // every corner, every tag
     // Scale: the distance between points 0 and 1 is one square (checkerboard) or one tag side.
-    const double expected_px = (t.type == TargetType::checkerboard ? t.square : t.tag_size) * dpi / 0.0254;
+    const double expected_px =
+        (t.type == TargetType::checkerboard ? t.square : t.tag_size) * dpi / 0.0254;
     size_t i0 = 0, i1 = 0;
     for (size_t k = 0; k < d.point_ids.size(); ++k) {
       if (d.point_ids[k] == 0) i0 = k;
@@ -233,6 +240,61 @@ TEST(TargetPdf, RendersBackToTheTargetAtExactScale) {
     }
   }
   std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rigcal::camera
+
+namespace rigcal::camera {
+namespace {
+
+// Acceptance 2, mrcal: mrcal-calibrate-cameras on rigcal's own corners.vnl, same model
+// (LENSMODEL_OPENCV4 = k1 k2 p1 p2), without mrcal's board-warp parameters (rigcal has none).
+// Both report the per-coordinate RMS; mrcal's includes its regularization.
+TEST(CameraPeers, MrcalOnTheSameCorners) {
+  RIGCAL_REQUIRE_FIXTURE(dir, "stereo/opencv_samples");
+  if (std::system("command -v mrcal-calibrate-cameras > /dev/null") != 0) {
+    GTEST_SKIP() << "mrcal-calibrate-cameras (Debian package mrcal) not installed";
+  }
+  const Target target =
+      io::read_target_file(RIGCAL_SOURCE_DIR "/targets/checkerboard_9x6_25mm.yaml");
+  const std::vector<CameraInput> cams = opencv_sample_detections(dir, target);
+  const CalibrationResult ours = calibrate(target, cams);
+  std::vector<std::string> names;
+  std::vector<Detection> detections;
+  const int ids[] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 11, 12, 13, 14};
+  for (int c = 0; c < 2; ++c) {
+    for (size_t f = 0; f < 13; ++f) {
+      names.push_back(fmt::format("{}/{}{:02d}.jpg", dir, c ? "right" : "left", ids[f]));
+      detections.push_back(cams[c].frames[f]);
+    }
+  }
+  const std::filesystem::path work =
+      std::filesystem::temp_directory_path() / ("rigcal_mrcal_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(work);
+  std::ofstream((work / "corners.vnl").string()) << io::corners_vnl(target, names, detections);
+  const std::string cmd = fmt::format(
+      "cd {} && mrcal-calibrate-cameras --corners-cache corners.vnl --lensmodel LENSMODEL_OPENCV4 "
+      "--focal 535 "
+      "--object-spacing 0.025 --object-width-n 9 --object-height-n 6 --imagersize 640 480 --outdir "
+      ". "
+      "--skip-calobject-warp-solve '{}/left*.jpg' '{}/right*.jpg' > mrcal.log 2>&1",
+      work.string(), dir, dir);
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  std::ifstream log((work / "mrcal.log").string());
+  std::string line;
+  double mrcal_rms = -1;
+  while (std::getline(log, line)) {
+    if (line.rfind("## RMS error: ", 0) == 0) mrcal_rms = std::stod(line.substr(14));
+  }
+  ASSERT_GT(mrcal_rms, 0) << "no RMS in mrcal's output";
+  std::printf(
+      "per-coordinate RMS on the same corners, k1 k2 p1 p2, outliers rejected: rigcal %.5f px (%zu "
+      "outliers), mrcal %.5f px\n",
+      ours.rms_coord_px, ours.n_outliers, mrcal_rms);
+  RecordProperty("mrcal_rms_per_coordinate_px", std::to_string(mrcal_rms));
+  EXPECT_LE(ours.rms_coord_px, 1.01 * mrcal_rms);
+  std::filesystem::remove_all(work);
 }
 
 }  // namespace
