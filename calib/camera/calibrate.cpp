@@ -339,17 +339,24 @@ CalibrationResult calibrate(const Target& target, const std::vector<CameraInput>
     blocks.push_back(cam_pose[c].q.coeffs().data());
     blocks.push_back(cam_pose[c].t.data());
   }
-  ceres::Covariance::Options co;
-  co.algorithm_type = ceres::DENSE_SVD;
-  co.null_space_rank = -1;
-  ceres::Covariance covariance(co);
+  // Sparse QR first (fast on hundreds of board poses); dense SVD, which copes with a rank-deficient
+  // problem, when it fails.
   const int n_cov = static_cast<int>(cams.size()) * NK + 6 * (static_cast<int>(cams.size()) - 1);
   res.covariance = Eigen::MatrixXd::Zero(n_cov, n_cov);
   bool have_cov = false;
-  if (covariance.Compute(blocks, &problem)) {
+  for (const ceres::CovarianceAlgorithmType algorithm : {ceres::SPARSE_QR, ceres::DENSE_SVD}) {
+    ceres::Covariance::Options co;
+    co.algorithm_type = algorithm;
+    co.null_space_rank = algorithm == ceres::DENSE_SVD ? -1 : 0;
+    co.num_threads = 2;
+    ceres::Covariance covariance(co);
+    if (!covariance.Compute(blocks, &problem)) continue;
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> cov(n_cov, n_cov);
     have_cov = covariance.GetCovarianceMatrixInTangentSpace(blocks, cov.data());
-    res.covariance = cov * (res.noise_sigma_px * res.noise_sigma_px);
+    if (have_cov) {
+      res.covariance = cov * (res.noise_sigma_px * res.noise_sigma_px);
+      break;
+    }
   }
   if (!have_cov)
     res.notes.push_back(

@@ -41,16 +41,23 @@ Detection detect_checkerboard(const cv::Mat& gray, const Target& t, const Detect
   else
     probe = gray;
   std::vector<cv::Point2f> corners;
+  double found_scale = scale;
   bool ok = cv::findChessboardCornersSB(probe, pattern, corners, cv::CALIB_CB_NORMALIZE_IMAGE);
-  if (!ok) {
-    ok = cv::findChessboardCorners(probe, pattern, corners,
+  if (!ok && scale < 1.0) {
+    // Small or steep boards are lost in the probe: try once at full resolution (0.1-0.2 s).
+    ok = cv::findChessboardCornersSB(gray, pattern, corners, cv::CALIB_CB_NORMALIZE_IMAGE);
+    found_scale = 1.0;
+  }
+  if (!ok && scale == 1.0) {
+    // Small images: the classic detector is quick there and finds some boards SB misses.
+    ok = cv::findChessboardCorners(gray, pattern, corners,
                                    cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE);
   }
   if (!ok) {
     d.note = "no checkerboard";
     return d;
   }
-  for (cv::Point2f& c : corners) c *= static_cast<float>(1.0 / scale);
+  for (cv::Point2f& c : corners) c *= static_cast<float>(1.0 / found_scale);
   // Square size in px, from neighbours along the rows.
   std::vector<double> sq;
   for (int j = 0; j < t.rows; ++j) {

@@ -72,6 +72,7 @@ void apply_sim_config(std::string_view text, std::string_view file, sim::SimConf
       {"stereo.max_tilt_deg", num(c.boards.max_tilt_deg)},
       {"stereo.max_roll_deg", num(c.boards.max_roll_deg)},
       {"stereo.margin_px", num(c.boards.margin_px)},
+      {"stereo.min_square_px", num(c.boards.min_square_px)},
       {"stereo.frame_period_s", num(c.frame_period_s)},
       {"image.supersample", integer(c.image.supersample)},
       {"image.blur_sigma_px", num(c.image.blur_sigma_px)},

@@ -33,7 +33,9 @@ std::string target_pdf(const camera::Target& t) {
   // Board frame -> page: x right; checkerboard rows go down the page, AprilGrid rows go up.
   const bool rows_up = t.type == camera::TargetType::aprilgrid;
   auto X = [&](double x) { return (kPageMargin + x - o.x_min) * kPtPerM; };
-  auto Y = [&](double y) { return (kPageMargin + (rows_up ? o.y_max - y : y - o.y_min)) * kPtPerM; };
+  auto Y = [&](double y) {
+    return (kPageMargin + (rows_up ? o.y_max - y : y - o.y_min)) * kPtPerM;
+  };
   auto black_rect = [&](double x0, double y0, double x1, double y1) {
     const double a = X(x0), b = X(x1), c = Y(y0), d = Y(y1);
     cairo_rectangle(cr, std::min(a, b), std::min(c, d), std::abs(b - a), std::abs(d - c));
@@ -43,13 +45,15 @@ std::string target_pdf(const camera::Target& t) {
   // The board's outline, thin and grey, to cut along.
   cairo_set_source_rgb(cr, 0.7, 0.7, 0.7);
   cairo_set_line_width(cr, 0.3);
-  cairo_rectangle(cr, X(o.x_min), std::min(Y(o.y_min), Y(o.y_max)), o.width() * kPtPerM, o.height() * kPtPerM);
+  cairo_rectangle(cr, X(o.x_min), std::min(Y(o.y_min), Y(o.y_max)), o.width() * kPtPerM,
+                  o.height() * kPtPerM);
   cairo_stroke(cr);
   cairo_set_source_rgb(cr, 0, 0, 0);
   if (t.type == camera::TargetType::checkerboard) {
     for (int j = -1; j < t.rows; ++j) {
       for (int i = -1; i < t.cols; ++i) {
-        if (((i + j) % 2 + 2) % 2 == 0) black_rect(i * t.square, j * t.square, (i + 1) * t.square, (j + 1) * t.square);
+        if (((i + j) % 2 + 2) % 2 == 0)
+          black_rect(i * t.square, j * t.square, (i + 1) * t.square, (j + 1) * t.square);
       }
     }
   } else {
@@ -63,7 +67,8 @@ std::string target_pdf(const camera::Target& t) {
         for (int v = 0; v < 10; ++v) {
           for (int u = 0; u < 10; ++u) {
             const double x = c * pitch + u * cell, y = r * pitch + v * cell;
-            if (pattern.albedo(x + 0.5 * cell, y + 0.5 * cell) < 0.5) black_rect(x, y, x + cell, y + cell);
+            if (pattern.albedo(x + 0.5 * cell, y + 0.5 * cell) < 0.5)
+              black_rect(x, y, x + cell, y + cell);
           }
         }
       }
@@ -75,15 +80,22 @@ std::string target_pdf(const camera::Target& t) {
   cairo_set_font_size(cr, 9.0);
   const std::string desc =
       t.type == camera::TargetType::checkerboard
-          ? fmt::format("{}: checkerboard, {} x {} inner corners, squares {:.1f} mm; board {:.1f} x {:.1f} mm.", t.name,
-                        t.cols, t.rows, 1000 * t.square, 1000 * o.width(), 1000 * o.height())
-          : fmt::format("{}: AprilGrid tag36h11, {} x {} tags of {:.1f} mm, spacing {:g}; tag 0 bottom left; board {:.1f} x {:.1f} mm.",
-                        t.name, t.cols, t.rows, 1000 * t.tag_size, t.tag_spacing, 1000 * o.width(), 1000 * o.height());
+          ? fmt::format(
+                "{}: checkerboard, {} x {} inner corners, squares {:.1f} mm; board {:.1f} x {:.1f} "
+                "mm.",
+                t.name, t.cols, t.rows, 1000 * t.square, 1000 * o.width(), 1000 * o.height())
+          : fmt::format(
+                "{}: AprilGrid tag36h11, {} x {} tags of {:.1f} mm, spacing {:g}; tag 0 bottom "
+                "left; board {:.1f} x {:.1f} mm.",
+                t.name, t.cols, t.rows, 1000 * t.tag_size, t.tag_spacing, 1000 * o.width(),
+                1000 * o.height());
   const double text_y = (o.height() + 2 * kPageMargin) * kPtPerM + 6.0;
   cairo_move_to(cr, kPageMargin * kPtPerM, text_y);
   cairo_show_text(cr, desc.c_str());
   cairo_move_to(cr, kPageMargin * kPtPerM, text_y + 11.0);
-  cairo_show_text(cr, fmt::format("Print at 100 % (no fit-to-page). The bar measures 100 mm. {}", version_string()).c_str());
+  cairo_show_text(cr, fmt::format("Print at 100 % (no fit-to-page). The bar measures 100 mm. {}",
+                                  version_string())
+                          .c_str());
   const double bar_y = (o.height() + kPageMargin) * kPtPerM + 0.5 * kPageMargin * kPtPerM;
   cairo_rectangle(cr, kPageMargin * kPtPerM, bar_y, 0.100 * kPtPerM, 2.0);
   cairo_fill(cr);
@@ -91,7 +103,8 @@ std::string target_pdf(const camera::Target& t) {
   cairo_surface_finish(surface);
   const cairo_status_t status = cairo_surface_status(surface);
   cairo_surface_destroy(surface);
-  if (status != CAIRO_STATUS_SUCCESS) throw Error(fmt::format("cairo: {}", cairo_status_to_string(status)));
+  if (status != CAIRO_STATUS_SUCCESS)
+    throw Error(fmt::format("cairo: {}", cairo_status_to_string(status)));
   return pdf;
 }
 

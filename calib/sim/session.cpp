@@ -27,12 +27,12 @@ const rig::Sensor* imu_named(const rig::Rig& rig, std::string_view name) {
 
 camera::Target default_target() {
   camera::Target t;
-  t.name = "a3_checkerboard_8x5_45mm";
+  t.name = "a3_checkerboard_8x5_40mm";
   t.type = camera::TargetType::checkerboard;
   t.cols = 8;
   t.rows = 5;
-  t.square = 0.045;
-  t.margin = 0.0075;  // 405 x 270 mm of squares on a 420 x 285 mm board
+  t.square = 0.040;
+  t.margin = 0.028;  // a 28 mm quiet zone: 416 x 296 mm on an A3 sheet
   return t;
 }
 

@@ -17,8 +17,9 @@
 
 namespace rigcal::sim {
 
-// The A3 checkerboard rigcal assumes for a VBR-like rig: 8 x 5 inner corners, 45 mm squares
-// (420 x 297 mm sheet). The VBR paper does not give its board's numbers.
+// The A3 checkerboard rigcal assumes for a VBR-like rig: 8 x 5 inner corners, 40 mm squares,
+// a 28 mm white margin (416 x 296 mm on a 420 x 297 mm sheet). The VBR paper does not give its
+// board's numbers.
 camera::Target default_target();
 
 struct SimConfig {

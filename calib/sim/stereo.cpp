@@ -29,6 +29,27 @@ bool fully_visible(const rig::CameraModel& cam, const SE3& T_cam_board,
   return true;
 }
 
+// The smallest image distance between neighbouring object points (foreshortened squares).
+double smallest_spacing(const rig::CameraModel& cam, const SE3& T_cam_board,
+                        const camera::Target& target) {
+  const std::vector<Eigen::Vector3d> pts = camera::object_points(target);
+  const int cols = target.type == camera::TargetType::checkerboard ? target.cols : 2 * target.cols;
+  const int rows = static_cast<int>(pts.size()) / cols;
+  std::vector<Eigen::Vector2d> px;
+  for (const Eigen::Vector3d& p : pts)
+    px.push_back(camera::project(cam, T_cam_board * p).value_or(Eigen::Vector2d(NAN, NAN)));
+  double smallest = INFINITY;
+  for (int j = 0; j < rows; ++j) {
+    for (int i = 0; i < cols; ++i) {
+      if (i + 1 < cols)
+        smallest = std::min(smallest, (px[j * cols + i + 1] - px[j * cols + i]).norm());
+      if (j + 1 < rows)
+        smallest = std::min(smallest, (px[(j + 1) * cols + i] - px[j * cols + i]).norm());
+    }
+  }
+  return smallest;
+}
+
 }  // namespace
 
 std::vector<SE3> board_poses(const rig::CameraModel& left, const rig::CameraModel* right,
@@ -55,7 +76,7 @@ std::vector<SE3> board_poses(const rig::CameraModel& left, const rig::CameraMode
     // the largest fill that fits (both cameras seeing the whole board bounds it for a stereo pair).
     double fill = cfg.min_fill + (cfg.max_fill - cfg.min_fill) * u01(rng);
     for (int attempt = 0; attempt < 4000 && !found; ++attempt) {
-      if (attempt > 0 && attempt % 50 == 0) fill = std::max(0.5 * cfg.min_fill, 0.95 * fill);
+      if (attempt > 0 && attempt % 50 == 0) fill = std::max(cfg.min_fill, 0.95 * fill);
       // Relax the cell after many failures (a large board may not fit in a corner).
       const bool relax = attempt > 2000;
       const double distance = left.fx * extent / (fill * left.width);
@@ -73,6 +94,9 @@ std::vector<SE3> board_poses(const rig::CameraModel& left, const rig::CameraMode
       T_cam_board.t = centre - T_cam_board.R * centre_board;
       if (!fully_visible(left, T_cam_board, check, cfg.margin_px)) continue;
       if (right && !fully_visible(*right, T_right_left * T_cam_board, check, cfg.margin_px))
+        continue;
+      if (smallest_spacing(left, T_cam_board, target) < cfg.min_square_px) continue;
+      if (right && smallest_spacing(*right, T_right_left * T_cam_board, target) < cfg.min_square_px)
         continue;
       poses.push_back(T_cam_board);
       found = true;

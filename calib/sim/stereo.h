@@ -30,6 +30,7 @@ struct BoardPoseConfig {
   double max_tilt_deg = 50.0;               // board normal away from the optical axis
   double max_roll_deg = 30.0;               // board rotation about the optical axis
   double margin_px = 8.0;                   // every board corner this far inside the image
+  double min_square_px = 8.0;               // the smallest distance between neighbouring points
 };
 
 // Board poses T_camL_board such that the whole board is seen by the left camera and, when
