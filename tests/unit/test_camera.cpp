@@ -305,3 +305,34 @@ TEST(CameraPeers, MrcalOnTheSameCorners) {
 
 }  // namespace
 }  // namespace rigcal::camera
+
+namespace rigcal::camera {
+namespace {
+
+TEST(CameraDetect, NoBoardIsAnAnswerAndAHalfTurnIsCaught) {
+  // An image without a board: found = false (the probe keeps this well under a second; speed is
+  // measured in doc/performance.md, not here).
+  cv::Mat noise(700, 1388, CV_8UC1);
+  cv::randu(noise, 60, 200);
+  const Target board = sim::default_target();
+  EXPECT_FALSE(detect(noise, board).found);
+  EXPECT_FALSE(detect(cv::Mat(700, 1388, CV_8UC1, cv::Scalar(128)), board).found);
+  // A board seen upside down: point 0 is still the same physical corner.
+  const rig::Rig rig = rig::read_rig_file(RIGCAL_SOURCE_DIR "/data/sample_rig.yaml");
+  sim::SimConfig cfg;
+  cfg.boards.views = 3;
+  const sim::StereoPart part = sim::simulate_stereo(rig, cfg);
+  for (size_t k = 0; k < part.left.size(); ++k) {
+    const Detection upright = detect(part.left[k], cfg.target);
+    cv::Mat turned;
+    cv::rotate(part.left[k], turned, cv::ROTATE_180);
+    const Detection flipped = detect(turned, cfg.target);
+    ASSERT_TRUE(upright.found && flipped.found);
+    const Eigen::Vector2d p0_turned(1387 - flipped.pixels[0].x(), 699 - flipped.pixels[0].y());
+    EXPECT_LT((p0_turned - upright.pixels[0]).norm(), 0.5) << "view " << k;
+    EXPECT_LT((upright.pixels[0] - part.corners_left[k][0]).norm(), 0.5) << "view " << k;
+  }
+}
+
+}  // namespace
+}  // namespace rigcal::camera

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
 #include "fixtures.h"
@@ -276,6 +277,64 @@ TEST_F(Cli, SimulateWritesTheLayoutAndNothingOnFailure) {
     EXPECT_NE(e.path().filename(), "x");
     EXPECT_NE(e.path().filename(), "y");
   }
+}
+
+TEST_F(Cli, CamerasErrorsAreOneLineAndWriteNothing) {
+  const std::string target = RIGCAL_SOURCE_DIR "/targets/checkerboard_9x6_25mm.yaml";
+  const std::string out = (dir_ / "out.yaml").string(), report = (dir_ / "rep").string();
+  CliRun r = run("cameras --target " + target + " --camera 'left=" + (dir_ / "none*.png").string() +
+                 "' --out " + out + " --report " + report);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("camera left: no file matches"), std::string::npos) << r.err;
+  // Images without the target anywhere.
+  cv::Mat blank(120, 160, CV_8UC1, cv::Scalar(128));
+  for (int i = 0; i < 3; ++i) cv::imwrite((dir_ / fmt::format("img{}.png", i)).string(), blank);
+  r = run("cameras --target " + target + " --camera 'left=" + (dir_ / "img*.png").string() +
+          "' --out " + out + " --report " + report);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("was found in none of the 3 images"), std::string::npos) << r.err;
+  // One camera, two image sizes.
+  cv::imwrite((dir_ / "img3.png").string(), cv::Mat(100, 100, CV_8UC1, cv::Scalar(128)));
+  r = run("cameras --target " + target + " --camera 'left=" + (dir_ / "img*.png").string() +
+          "' --out " + out + " --report " + report);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("one camera, one image size"), std::string::npos) << r.err;
+  // Two images of one camera with one frame number.
+  cv::imwrite((dir_ / "a_7.png").string(), blank);
+  cv::imwrite((dir_ / "b_7.png").string(), blank);
+  r = run("cameras --target " + target + " --camera 'left=" + (dir_ / "?_7.png").string() +
+          "' --out " + out + " --report " + report);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("have the same frame number 7"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_FALSE(fs::exists(report));
+}
+
+TEST_F(Cli, CamerasOnTheOpenCvSamplesWritesRigAndReport) {
+  RIGCAL_REQUIRE_FIXTURE(dir, "stereo/opencv_samples");
+  const std::string out = (dir_ / "calib.yaml").string(), report = (dir_ / "report").string();
+  CliRun r = run("cameras --target " RIGCAL_SOURCE_DIR
+                 "/targets/checkerboard_9x6_25mm.yaml --camera 'left=" +
+                 dir + "/left*.jpg' --camera 'right=" + dir + "/right*.jpg' --out " + out +
+                 " --report " + report);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(run("rig validate " + out).status, 0);
+  const nlohmann::json j = nlohmann::json::parse(slurp(fs::path(report) / "cameras.json"));
+  EXPECT_LE(j["rms_2d_px"].get<double>(), 0.20);
+  EXPECT_NEAR(j["cameras"][1]["T_cam_cam0"]["baseline_m"].get<double>(), 0.0832, 0.0004);
+  for (const char* f : {"corners.vnl", "left_corners.png", "left_residuals.png",
+                        "left_coverage.png", "right_uncertainty.png"}) {
+    EXPECT_TRUE(fs::exists(fs::path(report) / f)) << f;
+  }
+  // The second run reads the detections back from corners.vnl: same result.
+  r = run("cameras --target " RIGCAL_SOURCE_DIR
+          "/targets/checkerboard_9x6_25mm.yaml --camera 'left=" +
+          dir + "/left*.jpg' --camera 'right=" + dir + "/right*.jpg' --out " + out + " --report " +
+          report);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("26 from"), std::string::npos) << r.out;
+  const nlohmann::json j2 = nlohmann::json::parse(slurp(fs::path(report) / "cameras.json"));
+  EXPECT_EQ(j2["rms_2d_px"], j["rms_2d_px"]);
 }
 
 }  // namespace
