@@ -9,6 +9,7 @@
 #include "rigcal/core/error.h"
 #include "rigcal/io/files.h"
 #include "rigcal/io/target_yaml.h"
+#include "rigcal/io/yaml.h"
 
 namespace rigcal::io {
 namespace {
@@ -20,13 +21,7 @@ int line_of(const YAML::Node& n) { return n.Mark().is_null() ? 0 : n.Mark().line
 }  // namespace
 
 void apply_sim_config(std::string_view text, std::string_view file, sim::SimConfig& c) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(std::string(text));
-  } catch (const YAML::Exception& e) {
-    fail_at(file, e.mark.is_null() ? 0 : e.mark.line + 1, "",
-            fmt::format("YAML syntax error: {}", e.msg));
-  }
+  const YAML::Node root = io::load_yaml(text, file);
   if (root.IsNull()) return;
   const std::filesystem::path base = std::filesystem::path(std::string(file)).parent_path();
   std::string key_now;

@@ -7,17 +7,12 @@
 
 #include "rigcal/core/error.h"
 #include "rigcal/io/files.h"
+#include "rigcal/io/yaml.h"
 
 namespace rigcal::io {
 
 camera::Target parse_target_yaml(std::string_view text, std::string_view file) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(std::string(text));
-  } catch (const YAML::Exception& e) {
-    fail_at(file, e.mark.is_null() ? 0 : e.mark.line + 1, "",
-            fmt::format("YAML syntax error: {}", e.msg));
-  }
+  const YAML::Node root = io::load_yaml(text, file);
   if (!root.IsMap()) fail_at(file, 0, "", "expected a map with target_type");
   auto line = [](const YAML::Node& n) { return n.Mark().is_null() ? 0 : n.Mark().line + 1; };
   auto get = [&](const char* key) -> YAML::Node {

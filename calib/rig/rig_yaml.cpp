@@ -11,6 +11,7 @@
 #include "rigcal/core/text.h"
 #include "rigcal/core/version.h"
 #include "rigcal/io/files.h"
+#include "rigcal/io/yaml.h"
 #include "rigcal/rig/checks.h"
 
 namespace rigcal::rig {
@@ -355,13 +356,7 @@ std::string yaml_matrix4_rows(const SE3& T, std::string_view indent) {
 
 Rig parse_rig_yaml(std::string_view text, std::string_view file_name) {
   Reader r(file_name);
-  YAML::Node root;
-  try {
-    root = YAML::Load(std::string(text));
-  } catch (const YAML::Exception& e) {
-    fail_at(r.file(), e.mark.is_null() ? 0 : e.mark.line + 1, "",
-            fmt::format("YAML syntax error: {}", e.msg));
-  }
+  const YAML::Node root = io::load_yaml(text, r.file());
   if (!root || root.IsNull()) fail_at(r.file(), 0, "", "empty file: expected a map of sensors");
   if (!root.IsMap()) r.fail(root, "", "expected a map of sensors at the top level");
 
