@@ -278,7 +278,7 @@ CalibrationResult calibrate(const Target& target, const std::vector<CameraInput>
     so.max_num_iterations = 200;
     so.function_tolerance = 1e-12;
     so.parameter_tolerance = 1e-12;
-    so.num_threads = 2;
+    so.num_threads = 1;  // deterministic sums: the same corners give the same calibration
     ceres::Solver::Summary summary;
     ceres::Solve(so, &problem, &summary);
     if (!summary.IsSolutionUsable())
@@ -348,7 +348,7 @@ CalibrationResult calibrate(const Target& target, const std::vector<CameraInput>
     ceres::Covariance::Options co;
     co.algorithm_type = algorithm;
     co.null_space_rank = algorithm == ceres::DENSE_SVD ? -1 : 0;
-    co.num_threads = 2;
+    co.num_threads = 1;
     ceres::Covariance covariance(co);
     if (!covariance.Compute(blocks, &problem)) continue;
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> cov(n_cov, n_cov);

@@ -93,7 +93,8 @@ struct SimCase {
 
 // Simulated truth: the default 40 views of the A3 board at the default noise, 1388 x 700.
 // Returns, per checked quantity, the error in units of the reported 1-sigma.
-std::vector<double> check_against_truth(const SimCase& sc, uint64_t seed, bool print) {
+std::vector<double> check_against_truth(const SimCase& sc, uint64_t seed, bool print,
+                                        bool strict = true) {
   rig::Rig rig = rig::read_rig_file(RIGCAL_SOURCE_DIR "/data/sample_rig.yaml");
   rig::sensor(rig, "cam_l").camera.distortion_model = sc.model;
   rig::sensor(rig, "cam_r").camera.distortion_model = sc.model;
@@ -125,11 +126,15 @@ std::vector<double> check_against_truth(const SimCase& sc, uint64_t seed, bool p
           "%.3f, %.3f)\n",
           seed, c, f_rel, pp, r.cameras[c].stddev[2], r.cameras[c].stddev[3]);
     }
-    EXPECT_LE(f_rel, 2e-4) << "camera " << c;
+    if (strict) {
+      EXPECT_LE(f_rel, 2e-4) << "camera " << c;
+    }
     // The bar of 0.3 px is below what 40 views of the A3 board determine (reported
     // 1-sigma ~0.2-0.3 px, doc/cameras.md): asserted is that the reported uncertainty covers it.
-    EXPECT_LE(std::abs(est.cx - truth.cx), 3 * r.cameras[c].stddev[2]) << "camera " << c;
-    EXPECT_LE(std::abs(est.cy - truth.cy), 3 * r.cameras[c].stddev[3]) << "camera " << c;
+    if (strict) {
+      EXPECT_LE(std::abs(est.cx - truth.cx), 3 * r.cameras[c].stddev[2]) << "camera " << c;
+      EXPECT_LE(std::abs(est.cy - truth.cy), 3 * r.cameras[c].stddev[3]) << "camera " << c;
+    }
   }
   const double baseline_err = std::abs(r.T_cam_cam0[1].t.norm() - T_true.t.norm());
   const Eigen::Vector3d rot_err =
@@ -141,12 +146,16 @@ std::vector<double> check_against_truth(const SimCase& sc, uint64_t seed, bool p
         seed, 1000 * baseline_err, rot_err.norm(), r.rotation_stddev_deg[1].x(),
         r.rotation_stddev_deg[1].y(), r.rotation_stddev_deg[1].z(), r.rms_2d_px);
   }
-  EXPECT_LE(baseline_err, 2e-4);
+  if (strict) {
+    EXPECT_LE(baseline_err, 2e-4);
+  }
   // The bar of 0.01 deg is not met with this board: the reported 1-sigma is ~0.015 deg
   // about y, and the errors agree with it (doc/cameras.md). What is asserted: the reported
   // uncertainty covers the error.
-  EXPECT_LE(std::abs(rot_err.x()), 3 * r.rotation_stddev_deg[1].x() + 1e-4);
-  EXPECT_LE(std::abs(rot_err.y()), 3 * r.rotation_stddev_deg[1].y() + 1e-4);
+  if (strict) {
+    EXPECT_LE(std::abs(rot_err.x()), 3 * r.rotation_stddev_deg[1].x() + 1e-4);
+    EXPECT_LE(std::abs(rot_err.y()), 3 * r.rotation_stddev_deg[1].y() + 1e-4);
+  }
   // Errors in sigmas: fx, fy, cx, cy of both cameras, and the three rotation axes.
   std::vector<double> z;
   for (int c = 0; c < 2; ++c) {
