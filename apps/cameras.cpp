@@ -10,6 +10,7 @@
 #include <memory>
 #include <mutex>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "cli.h"
 #include "rigcal/camera/calibrate.h"
@@ -32,6 +33,7 @@ struct Options {
   std::string target, session, model = "pinhole-radtan", rig, out, report;
   std::vector<std::string> cameras;  // NAME=GLOB
   double k_sigma = 4.0;
+  std::string bayer;  // "", rggb, bggr, grbg, gbrg
 };
 
 std::vector<std::string> glob_files(const std::string& pattern) {
@@ -189,6 +191,19 @@ void run(const Options& o) {
   }
   const size_t n_cams = in.names.size(), n_frames = in.files[0].size();
 
+  // Raw Bayer images (like VBR's): OpenCV names the pattern by the 2x2 block's second row.
+  int bayer_code = -1;
+  if (o.bayer == "rggb")
+    bayer_code = cv::COLOR_BayerBG2GRAY;
+  else if (o.bayer == "bggr")
+    bayer_code = cv::COLOR_BayerRG2GRAY;
+  else if (o.bayer == "grbg")
+    bayer_code = cv::COLOR_BayerGB2GRAY;
+  else if (o.bayer == "gbrg")
+    bayer_code = cv::COLOR_BayerGR2GRAY;
+  else if (!o.bayer.empty())
+    throw Error(fmt::format("--bayer: expected rggb, bggr, grbg or gbrg, got '{}'", o.bayer));
+
   // Detections: from the cache when it was written for this target, else in parallel.
   std::map<std::string, camera::Detection> cache;
   const fs::path cache_path = fs::path(o.report) / "corners.vnl";
@@ -212,8 +227,13 @@ void run(const Options& o) {
   tbb::parallel_for(size_t(0), jobs.size(), [&](size_t j) {
     const auto [c, f] = jobs[j];
     const std::string& file = in.files[c][f];
-    const cv::Mat img = cv::imread(file, cv::IMREAD_GRAYSCALE);
+    cv::Mat img = cv::imread(file, cv::IMREAD_GRAYSCALE);
     if (img.empty()) throw Error(fmt::format("{}: cannot read the image", file));
+    if (bayer_code >= 0) {
+      cv::Mat gray;
+      cv::cvtColor(img, gray, bayer_code);  // raw mosaic to gray (edge-aware demosaicing)
+      img = gray;
+    }
     sizes[c][f] = img.size();
     if (auto it = cache.find(file); it != cache.end()) {
       cams[c].frames[f] = it->second;
@@ -379,6 +399,8 @@ void add_cameras(CLI::App& app) {
   cmd->add_option("--outlier-sigma", o->k_sigma,
                   "drop corners with a residual beyond this many sigma")
       ->capture_default_str();
+  cmd->add_option("--bayer", o->bayer,
+                  "raw Bayer images: rggb | bggr | grbg | gbrg (demosaiced to gray)");
   cmd->callback([o] { run(*o); });
 }
 

@@ -39,8 +39,14 @@ echo "Benchmark report (bench.json, trajectory_top.svg, ate_along.svg) in $out/b
 
 echo
 echo "== simulated session of the sample rig (truth in $out/sim/truth.yaml and truth.json)"
-printf "stereo:\n  views: 6\nscans:\n  count: 3\nlidar_camera:\n  pairs: 3\n" > "$out/sim.yaml"
+printf "stereo:\n  views: 12\nscans:\n  count: 3\nlidar_camera:\n  pairs: 3\n" > "$out/sim.yaml"
 "$rigcal" simulate --out "$out/sim" --config "$out/sim.yaml"
 echo
 "$rigcal" bench --gt "$out/sim/trajectories/truth_lidar.tum" \
   --est "$out/sim/trajectories/lidar_odometry.tum" | sed -n '1,8p'
+
+echo
+echo "== camera calibration of the simulated stereo images (truth: the sample rig)"
+"$rigcal" cameras --session "$out/sim/stereo" --target "$root/targets/a3_checkerboard_8x5_40mm.yaml" \
+  --rig "$sample" --out "$out/cameras/calib.yaml" --report "$out/cameras/report"
+echo "true values: cam_l fx 1085.3 fy 1084.7 cx 701.2 cy 349.6; baseline 0.4985 m (data/sample_rig.yaml)"

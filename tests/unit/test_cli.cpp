@@ -337,4 +337,30 @@ TEST_F(Cli, CamerasOnTheOpenCvSamplesWritesRigAndReport) {
   EXPECT_NEAR(j2["rms_2d_px"].get<double>(), j["rms_2d_px"].get<double>(), 1e-12);
 }
 
+TEST_F(Cli, CamerasOnASimulatedRawBayerSession) {
+  const fs::path cfg = write("b.yaml", "stereo:\n  views: 6\nimage:\n  bayer: true\n");
+  ASSERT_EQ(
+      run("simulate --out " + (dir_ / "s").string() + " --what stereo --config " + cfg.string())
+          .status,
+      0);
+  const CliRun r =
+      run("cameras --session " + (dir_ / "s" / "stereo").string() +
+          " --target " RIGCAL_SOURCE_DIR
+          "/targets/a3_checkerboard_8x5_40mm.yaml --bayer rggb --rig " RIGCAL_SOURCE_DIR
+          "/data/sample_rig.yaml --out " +
+          (dir_ / "c.yaml").string() + " --report " + (dir_ / "r").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(slurp(dir_ / "r" / "cameras.json"));
+  EXPECT_LT(j["rms_2d_px"].get<double>(), 0.15);
+  // The rig keeps its other sensors and cam_l's pose; cam_r moves to the calibrated extrinsic.
+  EXPECT_EQ(run("rig validate " + (dir_ / "c.yaml").string()).status, 0);
+  EXPECT_NE(slurp(dir_ / "c.yaml").find("gnss:"), std::string::npos);
+  EXPECT_EQ(run("cameras --session " + (dir_ / "s" / "stereo").string() +
+                " --target " RIGCAL_SOURCE_DIR
+                "/targets/a3_checkerboard_8x5_40mm.yaml --bayer xyz --out " +
+                (dir_ / "d.yaml").string() + " --report " + (dir_ / "d").string())
+                .status,
+            2);
+}
+
 }  // namespace
