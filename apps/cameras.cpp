@@ -1,6 +1,5 @@
 // rigcal cameras: intrinsics of one or two cameras and their stereo extrinsic (doc/cameras.md).
 #include <fmt/format.h>
-#include <glob.h>
 #include <tbb/parallel_for.h>
 #include <unistd.h>
 
@@ -21,6 +20,7 @@
 #include "rigcal/core/version.h"
 #include "rigcal/io/camera_report.h"
 #include "rigcal/io/files.h"
+#include "rigcal/io/image_sets.h"
 #include "rigcal/io/target_yaml.h"
 #include "rigcal/rig/rig_yaml.h"
 
@@ -35,125 +35,6 @@ struct Options {
   double k_sigma = 4.0;
   std::string bayer;  // "", rggb, bggr, grbg, gbrg
 };
-
-std::vector<std::string> glob_files(const std::string& pattern) {
-  glob_t g{};
-  std::vector<std::string> out;
-  if (::glob(pattern.c_str(), 0, nullptr, &g) == 0) {
-    for (size_t i = 0; i < g.gl_pathc; ++i) out.emplace_back(g.gl_pathv[i]);
-  }
-  globfree(&g);
-  std::sort(out.begin(), out.end());
-  return out;
-}
-
-// The last run of digits in the file name's stem.
-std::optional<long> frame_number(const std::string& path) {
-  const std::string stem = fs::path(path).stem().string();
-  size_t end = stem.find_last_of("0123456789");
-  if (end == std::string::npos) return std::nullopt;
-  size_t start = end;
-  while (start > 0 && std::isdigit(static_cast<unsigned char>(stem[start - 1]))) --start;
-  return std::stol(stem.substr(start, end - start + 1));
-}
-
-struct Inputs {
-  std::vector<std::string> names;
-  std::vector<std::vector<std::string>> files;  // per camera, per frame ("" = none)
-  std::vector<std::string> notes;
-};
-
-Inputs by_frame_number(const std::vector<std::pair<std::string, std::vector<std::string>>>& cams) {
-  Inputs in;
-  std::map<long, std::vector<std::string>> frames;
-  for (size_t c = 0; c < cams.size(); ++c) {
-    in.names.push_back(cams[c].first);
-    std::map<long, std::string> seen;
-    for (const std::string& f : cams[c].second) {
-      const std::optional<long> n = frame_number(f);
-      if (!n)
-        throw Error(
-            fmt::format("{}: no frame number in the file name; images are paired by it", f));
-      if (seen.count(*n))
-        throw Error(fmt::format("camera {}: {} and {} have the same frame number {}", cams[c].first,
-                                seen[*n], f, *n));
-      seen[*n] = f;
-      auto& row = frames[*n];
-      row.resize(cams.size());
-      row[c] = f;
-    }
-  }
-  in.files.assign(cams.size(), {});
-  size_t singles = 0;
-  for (const auto& [n, row] : frames) {
-    for (size_t c = 0; c < cams.size(); ++c) in.files[c].push_back(c < row.size() ? row[c] : "");
-    singles += std::count(row.begin(), row.end(), std::string()) > 0 || row.size() < cams.size();
-  }
-  if (cams.size() > 1 && singles)
-    in.notes.push_back(fmt::format("{} frames have an image from one camera only", singles));
-  return in;
-}
-
-Inputs from_session(const fs::path& dir) {
-  std::vector<std::pair<std::string, std::vector<std::string>>> cams;
-  std::vector<std::vector<Time>> stamps;
-  for (const auto& [folder, name] :
-       {std::pair{"camera_left", "cam_l"}, std::pair{"camera_right", "cam_r"}}) {
-    if (!fs::exists(dir / folder)) continue;
-    std::vector<std::string> files = glob_files((dir / folder / "data" / "*.png").string());
-    std::vector<Time> t;
-    const std::string text = io::read_text_file(dir / folder / "timestamps.txt");
-    size_t pos = 0;
-    int line = 0;
-    while (pos < text.size()) {
-      const size_t end = std::min(text.find('\n', pos), text.size());
-      ++line;
-      const std::string_view s = trim(std::string_view(text).substr(pos, end - pos));
-      if (!s.empty()) {
-        try {
-          t.push_back(parse_time(s));
-        } catch (const Error&) {
-          fail_at((dir / folder / "timestamps.txt").string(), line, "",
-                  fmt::format("expected a time, got '{}'", s));
-        }
-      }
-      pos = end + 1;
-    }
-    if (t.size() != files.size()) {
-      throw Error(fmt::format("{}: {} stamps for {} images", (dir / folder).string(), t.size(),
-                              files.size()));
-    }
-    cams.emplace_back(name, files);
-    stamps.push_back(t);
-  }
-  if (cams.empty())
-    throw Error(fmt::format("{}: no camera_left or camera_right folder", dir.string()));
-  Inputs in;
-  for (const auto& c : cams) in.names.push_back(c.first);
-  in.files.assign(cams.size(), {});
-  if (cams.size() == 1) {
-    in.files[0] = cams[0].second;
-    return in;
-  }
-  // Pair by stamp: the nearest right image within 5 ms of each left one.
-  std::vector<char> used(cams[1].second.size(), 0);
-  for (size_t i = 0; i < cams[0].second.size(); ++i) {
-    size_t best = 0;
-    int64_t best_d = INT64_MAX;
-    for (size_t j = 0; j < stamps[1].size(); ++j) {
-      const int64_t d = std::abs((stamps[1][j] - stamps[0][i]).ns);
-      if (d < best_d) best_d = d, best = j;
-    }
-    in.files[0].push_back(cams[0].second[i]);
-    if (best_d <= 5'000'000 && !used[best]) {
-      used[best] = 1;
-      in.files[1].push_back(cams[1].second[best]);
-    } else {
-      in.files[1].push_back("");
-    }
-  }
-  return in;
-}
 
 void run(const Options& o) {
   const camera::Target target = io::read_target_file(o.target);
@@ -170,9 +51,9 @@ void run(const Options& o) {
         o.model));
   copt.outlier_k_sigma = o.k_sigma;
 
-  Inputs in;
+  io::ImageSet in;
   if (!o.session.empty()) {
-    in = from_session(o.session);
+    in = io::read_session_images(o.session);
   } else {
     if (o.cameras.empty())
       throw Error("give --camera NAME=GLOB (once per camera) or --session DIR");
@@ -181,13 +62,13 @@ void run(const Options& o) {
       const size_t eq = spec.find('=');
       if (eq == std::string::npos || eq == 0)
         throw Error(fmt::format("--camera '{}': expected NAME=GLOB", spec));
-      std::vector<std::string> files = glob_files(spec.substr(eq + 1));
+      std::vector<std::string> files = io::glob_files(spec.substr(eq + 1));
       if (files.empty())
         throw Error(fmt::format("camera {}: no file matches '{}'", spec.substr(0, eq),
                                 spec.substr(eq + 1)));
       cams.emplace_back(spec.substr(0, eq), files);
     }
-    in = by_frame_number(cams);
+    in = io::pair_by_frame_number(cams);
   }
   const size_t n_cams = in.names.size(), n_frames = in.files[0].size();
 

@@ -1,0 +1,30 @@
+#pragma once
+// Sets of camera images, frame by frame (doc/cameras.md): from file globs paired by the frame
+// number in the file names, or from a session folder (camera_left/, camera_right/) paired by
+// timestamp. A frame may lack an image of some camera ("").
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace rigcal::io {
+
+struct ImageSet {
+  std::vector<std::string> names;               // cameras
+  std::vector<std::vector<std::string>> files;  // per camera, per frame ("" = none)
+  std::vector<std::string> notes;
+};
+
+// Sorted paths matching a shell glob.
+std::vector<std::string> glob_files(const std::string& pattern);
+// The last run of digits in the file name's stem.
+std::optional<long> frame_number(const std::string& path);
+// Pairs by frame number; throws rigcal::Error for a name without a number or a number used twice
+// in one camera.
+ImageSet pair_by_frame_number(
+    const std::vector<std::pair<std::string, std::vector<std::string>>>& cameras);
+// camera_left/ (cam_l) and camera_right/ (cam_r) of a session, paired by stamp within 5 ms.
+ImageSet read_session_images(const std::filesystem::path& session);
+
+}  // namespace rigcal::io
