@@ -40,6 +40,17 @@ void project(const T* k, bool radtan, int n_coeffs, const T* p, T* uv) {
   uv[1] = k[1] * yd + k[3];
 }
 
+// Projected minus observed, px.
+template <typename T>
+bool residual(const T* k, bool radtan, int n_coeffs, const Eigen::Matrix<T, 3, 1>& p,
+              const Eigen::Vector2d& observed, T* r) {
+  T uv[2];
+  project(k, radtan, n_coeffs, p.data(), uv);
+  r[0] = uv[0] - T(observed.x());
+  r[1] = uv[1] - T(observed.y());
+  return true;
+}
+
 // A corner seen by camera 0: intrinsics, board rotation and translation in camera 0.
 template <int NK>
 struct Cam0Error {
@@ -51,11 +62,7 @@ struct Cam0Error {
     const Eigen::Map<const Eigen::Quaternion<T>> q(q_board);
     const Eigen::Matrix<T, 3, 1> p =
         q * p_board.cast<T>() + Eigen::Map<const Eigen::Matrix<T, 3, 1>>(t_board);
-    T uv[2];
-    project(k, radtan, NK - 4, p.data(), uv);
-    r[0] = uv[0] - T(observed.x());
-    r[1] = uv[1] - T(observed.y());
-    return true;
+    return residual(k, radtan, NK - 4, p, observed, r);
   }
 };
 
@@ -72,11 +79,7 @@ struct CamCError {
     const Eigen::Matrix<T, 3, 1> p0 =
         qb * p_board.cast<T>() + Eigen::Map<const Eigen::Matrix<T, 3, 1>>(t_board);
     const Eigen::Matrix<T, 3, 1> p = qc * p0 + Eigen::Map<const Eigen::Matrix<T, 3, 1>>(t_c0);
-    T uv[2];
-    project(k, radtan, NK - 4, p.data(), uv);
-    r[0] = uv[0] - T(observed.x());
-    r[1] = uv[1] - T(observed.y());
-    return true;
+    return residual(k, radtan, NK - 4, p, observed, r);
   }
 };
 
