@@ -29,22 +29,28 @@ bool fully_visible(const rig::CameraModel& cam, const SE3& T_cam_board,
   return true;
 }
 
-// The smallest image distance between neighbouring object points (foreshortened squares).
+// The smallest distance between neighbouring checkerboard corners in the image (foreshortened
+// squares); AprilGrids are not limited this way (see board_poses).
 double smallest_spacing(const rig::CameraModel& cam, const SE3& T_cam_board,
                         const camera::Target& target) {
   const std::vector<Eigen::Vector3d> pts = camera::object_points(target);
-  const int cols = target.type == camera::TargetType::checkerboard ? target.cols : 2 * target.cols;
+  const bool grid = target.type == camera::TargetType::aprilgrid;
+  const int cols = grid ? 2 * target.cols : target.cols;
   const int rows = static_cast<int>(pts.size()) / cols;
   std::vector<Eigen::Vector2d> px;
-  for (const Eigen::Vector3d& p : pts)
+  for (const Eigen::Vector3d& p : pts) {
     px.push_back(camera::project(cam, T_cam_board * p).value_or(Eigen::Vector2d(NAN, NAN)));
+  }
   double smallest = INFINITY;
   for (int j = 0; j < rows; ++j) {
     for (int i = 0; i < cols; ++i) {
-      if (i + 1 < cols)
+      // Grid: only the sides of a tag (point 2c to 2c + 1), not the gaps between tags.
+      if (i + 1 < cols && (!grid || i % 2 == 0)) {
         smallest = std::min(smallest, (px[j * cols + i + 1] - px[j * cols + i]).norm());
-      if (j + 1 < rows)
+      }
+      if (j + 1 < rows && (!grid || j % 2 == 0)) {
         smallest = std::min(smallest, (px[(j + 1) * cols + i] - px[j * cols + i]).norm());
+      }
     }
   }
   return smallest;
@@ -95,9 +101,13 @@ std::vector<SE3> board_poses(const rig::CameraModel& left, const rig::CameraMode
       if (!fully_visible(left, T_cam_board, check, cfg.margin_px)) continue;
       if (right && !fully_visible(*right, T_right_left * T_cam_board, check, cfg.margin_px))
         continue;
-      if (smallest_spacing(left, T_cam_board, target) < cfg.min_square_px) continue;
-      if (right && smallest_spacing(*right, T_right_left * T_cam_board, target) < cfg.min_square_px)
-        continue;
+      if (target.type == camera::TargetType::checkerboard) {
+        if (smallest_spacing(left, T_cam_board, target) < cfg.min_square_px) continue;
+        if (right &&
+            smallest_spacing(*right, T_right_left * T_cam_board, target) < cfg.min_square_px) {
+          continue;
+        }
+      }
       poses.push_back(T_cam_board);
       found = true;
     }
