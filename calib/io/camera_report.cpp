@@ -242,10 +242,4 @@ cv::Mat uncertainty_png(const camera::UncertaintyMap& m, int width, int height) 
   return out;
 }
 
-std::string encode_png(const cv::Mat& image) {
-  std::vector<uchar> buf;
-  if (!cv::imencode(".png", image, buf)) throw Error("PNG encoding failed");
-  return std::string(buf.begin(), buf.end());
-}
-
 }  // namespace rigcal::io

@@ -10,6 +10,7 @@
 
 #include "rigcal/camera/calibrate.h"
 #include "rigcal/camera/uncertainty.h"
+#include "rigcal/io/png.h"
 
 namespace rigcal::io {
 
@@ -37,6 +38,5 @@ cv::Mat residuals_png(const camera::CalibrationResult& result, int camera, int w
                       double magnify);
 cv::Mat coverage_png(const camera::CalibrationResult& result, int camera, int width, int height);
 cv::Mat uncertainty_png(const camera::UncertaintyMap& map, int width, int height);
-std::string encode_png(const cv::Mat& image);
 
 }  // namespace rigcal::io

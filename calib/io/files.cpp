@@ -34,12 +34,17 @@ std::string read_text_file(const fs::path& path) {
   return text;
 }
 
+namespace {
+
+// A temporary path beside `path` (same folder, so that the rename is atomic).
 fs::path temporary_sibling(const fs::path& path) {
   static std::atomic<int> counter{0};
   fs::path tmp = path;
   tmp += fmt::format(".tmp-{}-{}{}", ::getpid(), counter++, path.extension().string());
   return tmp;
 }
+
+}  // namespace
 
 void write_files_atomic(const std::vector<OutputFile>& files) {
   std::vector<fs::path> temps;

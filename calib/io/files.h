@@ -20,8 +20,4 @@ struct OutputFile {
 void write_files_atomic(const std::vector<OutputFile>& files);
 void write_file_atomic(const std::filesystem::path& path, const std::string& content);
 
-// A temporary path beside `path` (same folder, so a rename is atomic), for writers that need a
-// file name (cv::FileStorage). The caller renames or removes it.
-std::filesystem::path temporary_sibling(const std::filesystem::path& path);
-
 }  // namespace rigcal::io

@@ -8,17 +8,12 @@
 #include "rigcal/core/error.h"
 #include "rigcal/core/text.h"
 #include "rigcal/io/files.h"
+#include "rigcal/io/png.h"
 #include "rigcal/io/trajectory_io.h"
 
 namespace rigcal::io {
 namespace fs = std::filesystem;
 namespace {
-
-std::string png(const cv::Mat& image) {
-  std::vector<uchar> buffer;
-  if (!cv::imencode(".png", image, buffer)) throw Error("PNG encoding failed");
-  return std::string(buffer.begin(), buffer.end());
-}
 
 std::string frame_name(size_t k, std::string_view ext) { return fmt::format("{:010d}.{}", k, ext); }
 
@@ -47,7 +42,7 @@ void write_camera(const fs::path& dir, const std::vector<Time>& stamps,
   std::vector<OutputFile> files{{dir / "timestamps.txt", timestamps_txt(stamps)},
                                 {dir / "corners_truth.csv", corners_csv(corners)}};
   for (size_t k = 0; k < images.size(); ++k)
-    files.push_back({dir / "data" / frame_name(k, "png"), png(images[k])});
+    files.push_back({dir / "data" / frame_name(k, "png"), encode_png(images[k])});
   write_files_atomic(files);
 }
 

@@ -16,8 +16,6 @@ namespace {
 
 using Setter = std::function<void(const YAML::Node&)>;
 
-int line_of(const YAML::Node& n) { return n.Mark().is_null() ? 0 : n.Mark().line + 1; }
-
 }  // namespace
 
 void apply_sim_config(std::string_view text, std::string_view file, sim::SimConfig& c) {
@@ -116,7 +114,7 @@ void apply_sim_config(std::string_view text, std::string_view file, sim::SimConf
   setters.merge(imu("os_imu", c.os_imu));
   std::function<void(const YAML::Node&, const std::string&)> walk = [&](const YAML::Node& map,
                                                                         const std::string& prefix) {
-    if (!map.IsMap()) fail_at(file, line_of(map), prefix, "expected a map of keys");
+    if (!map.IsMap()) fail_at(file, yaml_line(map), prefix, "expected a map of keys");
     for (auto it = map.begin(); it != map.end(); ++it) {
       const std::string key =
           prefix.empty() ? it->first.Scalar() : prefix + "." + it->first.Scalar();
@@ -125,14 +123,14 @@ void apply_sim_config(std::string_view text, std::string_view file, sim::SimConf
         try {
           s->second(it->second);
         } catch (const YAML::Exception&) {
-          fail_at(file, line_of(it->second), key, "wrong type of value");
+          fail_at(file, yaml_line(it->second), key, "wrong type of value");
         } catch (const Error& e) {
-          fail_at(file, line_of(it->second), key, e.what());
+          fail_at(file, yaml_line(it->second), key, e.what());
         }
       } else if (it->second.IsMap()) {
         walk(it->second, key);
       } else {
-        fail_at(file, line_of(it->first), key, "unknown key (doc/simulator.md lists the keys)");
+        fail_at(file, yaml_line(it->first), key, "unknown key (doc/simulator.md lists the keys)");
       }
     }
   };

@@ -14,7 +14,7 @@ namespace rigcal::io {
 camera::Target parse_target_yaml(std::string_view text, std::string_view file) {
   const YAML::Node root = io::load_yaml(text, file);
   if (!root.IsMap()) fail_at(file, 0, "", "expected a map with target_type");
-  auto line = [](const YAML::Node& n) { return n.Mark().is_null() ? 0 : n.Mark().line + 1; };
+  auto line = [](const YAML::Node& n) { return yaml_line(n); };
   auto get = [&](const char* key) -> YAML::Node {
     const YAML::Node n = root[key];
     if (!n) fail_at(file, line(root), key, "missing required key");

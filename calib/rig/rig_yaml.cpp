@@ -44,7 +44,7 @@ class Reader {
   [[noreturn]] void fail(const YAML::Node& at, std::string_view key, std::string_view what) const {
     fail_at(file_, line_of(at), key, what);
   }
-  int line_of(const YAML::Node& n) const { return n.Mark().is_null() ? 0 : n.Mark().line + 1; }
+  int line_of(const YAML::Node& n) const { return io::yaml_line(n); }
   void remember(const std::string& key, const YAML::Node& n) { lines_[key] = line_of(n); }
   int line_of_key(const std::string& key) const {
     auto it = lines_.find(key);

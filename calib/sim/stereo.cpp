@@ -33,24 +33,16 @@ bool fully_visible(const rig::CameraModel& cam, const SE3& T_cam_board,
 // squares); AprilGrids are not limited this way (see board_poses).
 double smallest_spacing(const rig::CameraModel& cam, const SE3& T_cam_board,
                         const camera::Target& target) {
-  const std::vector<Eigen::Vector3d> pts = camera::object_points(target);
-  const bool grid = target.type == camera::TargetType::aprilgrid;
-  const int cols = grid ? 2 * target.cols : target.cols;
-  const int rows = static_cast<int>(pts.size()) / cols;
   std::vector<Eigen::Vector2d> px;
-  for (const Eigen::Vector3d& p : pts) {
+  for (const Eigen::Vector3d& p : camera::object_points(target)) {
     px.push_back(camera::project(cam, T_cam_board * p).value_or(Eigen::Vector2d(NAN, NAN)));
   }
   double smallest = INFINITY;
-  for (int j = 0; j < rows; ++j) {
-    for (int i = 0; i < cols; ++i) {
-      // Grid: only the sides of a tag (point 2c to 2c + 1), not the gaps between tags.
-      if (i + 1 < cols && (!grid || i % 2 == 0)) {
-        smallest = std::min(smallest, (px[j * cols + i + 1] - px[j * cols + i]).norm());
-      }
-      if (j + 1 < rows && (!grid || j % 2 == 0)) {
-        smallest = std::min(smallest, (px[(j + 1) * cols + i] - px[j * cols + i]).norm());
-      }
+  for (int j = 0; j < target.rows; ++j) {
+    for (int i = 0; i < target.cols; ++i) {
+      const int k = j * target.cols + i;
+      if (i + 1 < target.cols) smallest = std::min(smallest, (px[k + 1] - px[k]).norm());
+      if (j + 1 < target.rows) smallest = std::min(smallest, (px[k + target.cols] - px[k]).norm());
     }
   }
   return smallest;

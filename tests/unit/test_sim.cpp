@@ -96,7 +96,6 @@ TEST(SimStereo, RenderedCornersMatchTruthToSubPixel) {
   cfg.boards.views = 9;
   const StereoPart part = simulate_stereo(rig, cfg);
   ASSERT_EQ(part.left.size(), 9u);
-  const cv::Size size(cfg.target.cols, cfg.target.rows);
   double sse = 0.0;
   size_t n = 0, detected = 0;
   for (size_t k = 0; k < part.left.size(); ++k) {
