@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <cctype>
 #include <charconv>
 #include <cmath>
 
@@ -61,6 +62,29 @@ std::string format_double(double value, bool keep_point) {
   const size_t e = s.find('e');
   if (e == std::string::npos) return s + ".0";
   return s.insert(e, ".0");
+}
+
+std::vector<TextLine> data_lines(std::string_view text, std::string* headers) {
+  std::vector<TextLine> lines;
+  int number = 0;
+  size_t pos = 0;
+  while (pos <= text.size()) {
+    size_t end = text.find('\n', pos);
+    if (end == std::string_view::npos) end = text.size();
+    std::string_view line = trim(text.substr(pos, end - pos));
+    ++number;
+    if (!line.empty()) {
+      if (line.front() == '#' ||
+          (lines.empty() && std::isalpha(static_cast<unsigned char>(line.front())))) {
+        if (headers) *headers += std::string(line) + "\n";
+      } else {
+        lines.push_back({line, number});
+      }
+    }
+    if (end == text.size()) break;
+    pos = end + 1;
+  }
+  return lines;
 }
 
 }  // namespace rigcal

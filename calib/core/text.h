@@ -22,4 +22,12 @@ std::string format_double(double value, bool keep_point = false);
 
 std::string_view trim(std::string_view s);
 
+struct TextLine {
+  std::string_view text;  // trimmed
+  int number;             // 1-based
+};
+// The non-empty lines of a text file that are not comments ('#') or a header (a first line that
+// starts with a letter); `headers`, when given, receives the comment and header lines.
+std::vector<TextLine> data_lines(std::string_view text, std::string* headers);
+
 }  // namespace rigcal

@@ -12,35 +12,6 @@ namespace {
 constexpr const char* kTumFields[] = {"t", "tx", "ty", "tz", "qx", "qy", "qz", "qw"};
 constexpr const char* kEurocFields[] = {"timestamp", "px", "py", "pz", "qw", "qx", "qy", "qz"};
 
-struct Line {
-  std::string_view text;
-  int number;  // 1-based
-};
-
-// Non-empty lines that are not comments; `headers` gets the comment and header lines.
-std::vector<Line> data_lines(std::string_view text, std::string* headers) {
-  std::vector<Line> lines;
-  int number = 0;
-  size_t pos = 0;
-  while (pos <= text.size()) {
-    size_t end = text.find('\n', pos);
-    if (end == std::string_view::npos) end = text.size();
-    std::string_view line = trim(text.substr(pos, end - pos));
-    ++number;
-    if (!line.empty()) {
-      if (line.front() == '#' ||
-          (lines.empty() && std::isalpha(static_cast<unsigned char>(line.front())))) {
-        if (headers) *headers += std::string(line) + "\n";
-      } else {
-        lines.push_back({line, number});
-      }
-    }
-    if (end == text.size()) break;
-    pos = end + 1;
-  }
-  return lines;
-}
-
 bool is_integer_text(std::string_view s) {
   if (s.empty()) return false;
   for (char c : s) {
@@ -49,7 +20,7 @@ bool is_integer_text(std::string_view s) {
   return true;
 }
 
-TrajectoryFormat detect(const std::vector<Line>& lines, const std::string& headers,
+TrajectoryFormat detect(const std::vector<TextLine>& lines, const std::string& headers,
                         std::string_view file_name) {
   if (headers.find("[ns]") != std::string::npos || headers.find("p_RS_R") != std::string::npos) {
     return TrajectoryFormat::euroc;
@@ -70,7 +41,7 @@ TrajectoryFormat detect(const std::vector<Line>& lines, const std::string& heade
   fail_at(file, line, "", fmt::format("field {} ({}): {}", field + 1, name, what));
 }
 
-double number(std::string_view file, const Line& line, const std::vector<std::string_view>& f,
+double number(std::string_view file, const TextLine& line, const std::vector<std::string_view>& f,
               size_t i, std::string_view name) {
   try {
     return parse_double(f[i], name);
@@ -80,8 +51,8 @@ double number(std::string_view file, const Line& line, const std::vector<std::st
   }
 }
 
-Eigen::Quaterniond quaternion(std::string_view file, const Line& line, double w, double x, double y,
-                              double z) {
+Eigen::Quaterniond quaternion(std::string_view file, const TextLine& line, double w, double x,
+                              double y, double z) {
   const Eigen::Quaterniond q(w, x, y, z);
   const double norm = q.norm();
   if (!(norm > 1e-6)) fail_at(file, line.number, "", "zero quaternion");
@@ -120,7 +91,7 @@ std::string_view to_string(TrajectoryFormat format) {
 TrajectoryFile parse_trajectory(std::string_view text, std::string_view file_name,
                                 const TrajectoryReadOptions& options) {
   std::string headers;
-  const std::vector<Line> lines = data_lines(text, &headers);
+  const std::vector<TextLine> lines = data_lines(text, &headers);
   if (lines.empty()) fail_at(file_name, 0, "", "no poses: the file is empty or all comments");
   TrajectoryFile out;
   out.format = options.format == TrajectoryFormat::automatic ? detect(lines, headers, file_name)
@@ -131,7 +102,7 @@ TrajectoryFile parse_trajectory(std::string_view text, std::string_view file_nam
   std::vector<int> line_of_pose;
   line_of_pose.reserve(lines.size());
 
-  for (const Line& line : lines) {
+  for (const TextLine& line : lines) {
     const std::vector<std::string_view> f = split_fields(line.text);
     SE3 T;
     Time stamp;
@@ -221,7 +192,7 @@ TrajectoryFile parse_trajectory(std::string_view text, std::string_view file_nam
     if (!options.kitti_times.empty()) {
       const std::string times_text = read_text_file(options.kitti_times);
       const std::string times_name = options.kitti_times.string();
-      const std::vector<Line> times = data_lines(times_text, nullptr);
+      const std::vector<TextLine> times = data_lines(times_text, nullptr);
       if (times.size() != traj.size()) {
         fail_at(times_name, 0, "",
                 fmt::format("{} times for {} poses of {}", times.size(), traj.size(), file_name));

@@ -1,0 +1,768 @@
+#include "rigcal/time_sync/time_sync.h"
+
+#include <fmt/format.h>
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <limits>
+#include <opencv2/core.hpp>
+#include <optional>
+
+#include "rigcal/core/error.h"
+#include "rigcal/core/se3.h"
+
+namespace rigcal::time_sync {
+namespace {
+
+// A stream in seconds since a common epoch. A step longer than gap_s is a gap: nothing is
+// interpolated across it.
+struct Series {
+  std::vector<double> t;
+  std::vector<Eigen::Vector3d> w;
+  double median_dt = 0.0, gap_s = 0.0, averaging_s = 0.0;
+  double rate_hz() const { return 1.0 / median_dt; }
+};
+
+double median(std::vector<double> v) {
+  if (v.empty()) return NAN;
+  const size_t n = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + n, v.end());
+  return v[n];
+}
+
+Series make_series(const AngularRates& in, Time epoch, std::string_view what) {
+  if (in.stamps.size() != in.rates.size())
+    throw Error(fmt::format("{}: {} stamps but {} rates", what, in.stamps.size(), in.rates.size()));
+  if (in.stamps.size() < 10)
+    throw Error(fmt::format("{}: {} samples; at least 10 are needed", what, in.stamps.size()));
+  Series s;
+  s.t.reserve(in.stamps.size());
+  std::vector<double> dt;
+  dt.reserve(in.stamps.size());
+  for (size_t k = 0; k < in.stamps.size(); ++k) {
+    if (k > 0 && in.stamps[k] <= in.stamps[k - 1]) {
+      throw Error(fmt::format("{}: stamps must increase (sample {}: {} after {})", what, k,
+                              to_seconds_text(in.stamps[k]), to_seconds_text(in.stamps[k - 1])));
+    }
+    if (!in.rates[k].allFinite()) throw Error(fmt::format("{}: sample {} is not finite", what, k));
+    s.t.push_back((in.stamps[k] - epoch).seconds());
+    if (k > 0) dt.push_back(s.t[k] - s.t[k - 1]);
+  }
+  s.w = in.rates;
+  s.median_dt = median(dt);
+  s.gap_s = 5.0 * s.median_dt;
+  s.averaging_s = in.averaging_s;
+  return s;
+}
+
+// The segment j with t[j] <= x < t[j+1] (x == t.back() belongs to the last one), or false when
+// x is outside or the step is a gap. `hint` makes monotone queries O(1).
+bool locate(const Series& s, double x, size_t& hint, size_t& j) {
+  const size_t n = s.t.size();
+  if (!(x >= s.t.front() && x <= s.t.back())) return false;
+  if (hint >= n - 1) hint = n - 2;
+  if (s.t[hint] <= x && x <= s.t[hint + 1]) {
+    j = hint;
+  } else if (hint + 2 < n && s.t[hint + 1] <= x && x <= s.t[hint + 2]) {
+    j = hint + 1;
+  } else {
+    j = static_cast<size_t>(std::upper_bound(s.t.begin(), s.t.end(), x) - s.t.begin());
+    j = std::min(j, n - 1) - 1;
+  }
+  hint = j;
+  return s.t[j + 1] - s.t[j] <= s.gap_s;
+}
+
+// Cubic Hermite interpolation with finite-difference tangents (linear next to a gap or an end).
+bool sample(const Series& s, double x, size_t& hint, Eigen::Vector3d& out) {
+  size_t j;
+  if (!locate(s, x, hint, j)) return false;
+  const double t0 = s.t[j], t1 = s.t[j + 1], h = t1 - t0;
+  const Eigen::Vector3d& p0 = s.w[j];
+  const Eigen::Vector3d& p1 = s.w[j + 1];
+  const Eigen::Vector3d secant = (p1 - p0) / h;
+  const bool has_prev = j > 0 && t0 - s.t[j - 1] <= s.gap_s;
+  const bool has_next = j + 2 < s.t.size() && s.t[j + 2] - t1 <= s.gap_s;
+  const Eigen::Vector3d m0 =
+      has_prev ? Eigen::Vector3d((p1 - s.w[j - 1]) / (t1 - s.t[j - 1])) : secant;
+  const Eigen::Vector3d m1 =
+      has_next ? Eigen::Vector3d((s.w[j + 2] - p0) / (s.t[j + 2] - t0)) : secant;
+  const double u = (x - t0) / h, u2 = u * u, u3 = u2 * u;
+  out = (2 * u3 - 3 * u2 + 1) * p0 + (u3 - 2 * u2 + u) * h * m0 + (-2 * u3 + 3 * u2) * p1 +
+        (u3 - u2) * h * m1;
+  return true;
+}
+
+// The mean over [x - width/2, x + width/2] of the piecewise-linear signal, for every sample whose
+// window lies inside one gap-free segment (others are dropped).
+Series box_filter(const Series& s, double width) {
+  const size_t n = s.t.size();
+  // Cumulative integral, restarting after each gap (segments are identified by `segment`).
+  std::vector<Eigen::Vector3d> I(n, Eigen::Vector3d::Zero());
+  std::vector<int> segment(n, 0);
+  for (size_t k = 1; k < n; ++k) {
+    const double h = s.t[k] - s.t[k - 1];
+    if (h > s.gap_s) {
+      segment[k] = segment[k - 1] + 1;
+    } else {
+      segment[k] = segment[k - 1];
+      I[k] = I[k - 1] + 0.5 * h * (s.w[k] + s.w[k - 1]);
+    }
+  }
+  auto integral = [&](double x, size_t& hint, int& seg, Eigen::Vector3d& v) {
+    size_t j;
+    if (!locate(s, x, hint, j)) return false;
+    const double tau = x - s.t[j], h = s.t[j + 1] - s.t[j];
+    v = I[j] + tau * s.w[j] + (s.w[j + 1] - s.w[j]) * (tau * tau / (2 * h));
+    seg = segment[j];
+    return true;
+  };
+  Series out;
+  out.median_dt = s.median_dt;
+  out.gap_s = s.gap_s;
+  out.averaging_s = width;
+  size_t h_lo = 0, h_hi = 0;
+  for (size_t k = 0; k < n; ++k) {
+    Eigen::Vector3d lo, hi;
+    int seg_lo, seg_hi;
+    if (!integral(s.t[k] - 0.5 * width, h_lo, seg_lo, lo)) continue;
+    if (!integral(s.t[k] + 0.5 * width, h_hi, seg_hi, hi) || seg_lo != seg_hi) continue;
+    out.t.push_back(s.t[k]);
+    out.w.push_back((hi - lo) / width);
+  }
+  if (out.t.size() < 10) throw Error("too few samples left after matching the streams' bandwidth");
+  return out;
+}
+
+// |w| on the lattice t = n * h for n in [n0, n0 + size), with a validity mask; the values have
+// their mean removed.
+struct Grid {
+  long n0 = 0;
+  std::vector<double> v, m;
+};
+
+Grid norm_grid(const Series& s, double h) {
+  Grid g;
+  g.n0 = static_cast<long>(std::ceil(s.t.front() / h));
+  const long n1 = static_cast<long>(std::floor(s.t.back() / h));
+  const size_t size = n1 >= g.n0 ? static_cast<size_t>(n1 - g.n0 + 1) : 0;
+  g.v.assign(size, 0.0);
+  g.m.assign(size, 0.0);
+  size_t hint = 0;
+  double sum = 0;
+  size_t count = 0;
+  for (size_t i = 0; i < size; ++i) {
+    Eigen::Vector3d w;
+    if (sample(s, (g.n0 + static_cast<long>(i)) * h, hint, w)) {
+      g.v[i] = w.norm();
+      g.m[i] = 1.0;
+      sum += g.v[i];
+      ++count;
+    }
+  }
+  const double mean = count ? sum / count : 0.0;
+  for (size_t i = 0; i < size; ++i) g.v[i] = g.m[i] > 0 ? g.v[i] - mean : 0.0;
+  return g;
+}
+
+// Masked normalized cross-correlation (Padfield 2010) for every lag k = n_a - n_b (offset k*h)
+// by FFT: the Pearson correlation of the overlapping valid samples. Entries with fewer than
+// min_count overlapping samples are NaN. Returns values for k in [k_first, k_first + size).
+std::vector<double> masked_ncc_fft(const Grid& a, const Grid& b, size_t min_count, long& k_first) {
+  const int na = static_cast<int>(a.v.size()), nb = static_cast<int>(b.v.size());
+  const int L = cv::getOptimalDFTSize(na + nb - 1);
+  auto spectrum = [L](const std::vector<double>& x, int power, const std::vector<double>& mask) {
+    cv::Mat row = cv::Mat::zeros(1, L, CV_64F);
+    for (size_t i = 0; i < x.size(); ++i) {
+      row.at<double>(0, static_cast<int>(i)) =
+          power == 0 ? mask[i] : (power == 1 ? x[i] : x[i] * x[i]) * mask[i];
+    }
+    cv::Mat f;
+    cv::dft(row, f);
+    return f;
+  };
+  const cv::Mat Fma = spectrum(a.v, 0, a.m), Fa = spectrum(a.v, 1, a.m),
+                Faa = spectrum(a.v, 2, a.m);
+  const cv::Mat Fmb = spectrum(b.v, 0, b.m), Fb = spectrum(b.v, 1, b.m),
+                Fbb = spectrum(b.v, 2, b.m);
+  auto corr = [](const cv::Mat& A, const cv::Mat& B) {
+    cv::Mat p, r;
+    cv::mulSpectrums(A, B, p, 0, /*conjB=*/true);
+    cv::idft(p, r, cv::DFT_SCALE | cv::DFT_REAL_OUTPUT);
+    return r;
+  };
+  const cv::Mat n = corr(Fma, Fmb), sa = corr(Fa, Fmb), sb = corr(Fma, Fb), saa = corr(Faa, Fmb),
+                sbb = corr(Fma, Fbb), sab = corr(Fa, Fb);
+  // Index m = i - j in [-(nb-1), na-1] sits at m mod L; k = m + (a.n0 - b.n0).
+  std::vector<double> out;
+  out.reserve(static_cast<size_t>(na + nb - 1));
+  k_first = -(nb - 1) + (a.n0 - b.n0);
+  for (int m = -(nb - 1); m <= na - 1; ++m) {
+    const int idx = m >= 0 ? m : m + L;
+    const double cnt = std::round(n.at<double>(0, idx));
+    if (cnt < static_cast<double>(min_count) || cnt < 3) {
+      out.push_back(NAN);
+      continue;
+    }
+    const double Sa = sa.at<double>(0, idx), Sb = sb.at<double>(0, idx);
+    const double va = saa.at<double>(0, idx) - Sa * Sa / cnt;
+    const double vb = sbb.at<double>(0, idx) - Sb * Sb / cnt;
+    const double cov = sab.at<double>(0, idx) - Sa * Sb / cnt;
+    out.push_back(va > 1e-12 * cnt && vb > 1e-12 * cnt ? cov / std::sqrt(va * vb) : NAN);
+  }
+  return out;
+}
+
+// The same correlation for one lag, directly; also returns the overlap count.
+double masked_ncc_direct(const Grid& a, const Grid& b, long k, size_t& count) {
+  // Pairs a[i], b[j] with (a.n0 + i) - (b.n0 + j) = k.
+  const long shift = k - (a.n0 - b.n0);  // i = j + shift
+  const long j0 = std::max(0L, -shift);
+  const long j1 = std::min(static_cast<long>(b.v.size()), static_cast<long>(a.v.size()) - shift);
+  double n = 0, Sa = 0, Sb = 0, Saa = 0, Sbb = 0, Sab = 0;
+  for (long j = j0; j < j1; ++j) {
+    const size_t i = static_cast<size_t>(j + shift);
+    const double m = a.m[i] * b.m[static_cast<size_t>(j)];
+    if (m == 0) continue;
+    const double x = a.v[i], y = b.v[static_cast<size_t>(j)];
+    n += 1;
+    Sa += x;
+    Sb += y;
+    Saa += x * x;
+    Sbb += y * y;
+    Sab += x * y;
+  }
+  count = static_cast<size_t>(n);
+  if (n < 3) return NAN;
+  const double va = Saa - Sa * Sa / n, vb = Sbb - Sb * Sb / n;
+  return va > 0 && vb > 0 ? (Sab - Sa * Sb / n) / std::sqrt(va * vb) : NAN;
+}
+
+// The vertex of the parabola through (-1, y0), (0, y1), (1, y2), in [-1, 1].
+double parabola_vertex(double y0, double y1, double y2) {
+  const double den = y0 - 2 * y1 + y2;
+  if (!(std::abs(den) > 0)) return 0.0;
+  return std::clamp(0.5 * (y0 - y2) / den, -1.0, 1.0);
+}
+
+// Minimizes f on [lo, hi] (golden section; f unimodal there).
+template <class F>
+double golden_minimize(F f, double lo, double hi, double tol) {
+  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+  double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
+  double f1 = f(x1), f2 = f(x2);
+  while (hi - lo > tol) {
+    if (f1 < f2) {
+      hi = x2;
+      x2 = x1;
+      f2 = f1;
+      x1 = hi - g * (hi - lo);
+      f1 = f(x1);
+    } else {
+      lo = x1;
+      x1 = x2;
+      f1 = f2;
+      x2 = lo + g * (hi - lo);
+      f2 = f(x2);
+    }
+  }
+  return 0.5 * (lo + hi);
+}
+
+// Pairs of reference and other rates at offset d: the slower stream's samples (those in
+// `points`), the faster one interpolated.
+struct Pairing {
+  const Series* slow;
+  const Series* fast;
+  bool slow_is_reference;
+  std::vector<size_t> points;  // indices into slow
+
+  // t_ref = t_other + d: the fast stream's time for a slow sample.
+  double fast_time(double t_slow, double d) const {
+    return slow_is_reference ? t_slow - d : t_slow + d;
+  }
+  // Calls f(w_ref, w_other, index in points) for every pair that can be interpolated.
+  template <class F>
+  size_t for_each(double d, F f) const {
+    size_t hint = 0, n = 0;
+    for (size_t q = 0; q < points.size(); ++q) {
+      const size_t i = points[q];
+      Eigen::Vector3d w;
+      if (!sample(*fast, fast_time(slow->t[i], d), hint, w)) continue;
+      if (slow_is_reference) {
+        f(slow->w[i], w, q);
+      } else {
+        f(w, slow->w[i], q);
+      }
+      ++n;
+    }
+    return n;
+  }
+};
+
+// Pearson correlation of |w_ref| and |w_other| at offset d.
+double norm_ncc(const Pairing& p, double d) {
+  double n = 0, Sa = 0, Sb = 0, Saa = 0, Sbb = 0, Sab = 0;
+  p.for_each(d, [&](const Eigen::Vector3d& wr, const Eigen::Vector3d& wo, size_t) {
+    const double x = wr.norm(), y = wo.norm();
+    n += 1;
+    Sa += x;
+    Sb += y;
+    Saa += x * x;
+    Sbb += y * y;
+    Sab += x * y;
+  });
+  if (n < 3) return NAN;
+  const double va = Saa - Sa * Sa / n, vb = Sbb - Sb * Sb / n;
+  return va > 0 && vb > 0 ? (Sab - Sa * Sb / n) / std::sqrt(va * vb) : NAN;
+}
+
+struct AxisFit {
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  double sse = NAN;
+  size_t n = 0;
+};
+
+// w_ref = R w_other + b by least squares (Kabsch on centred vectors) at offset d.
+AxisFit fit_axes(const Pairing& p, double d) {
+  Eigen::Vector3d sr = Eigen::Vector3d::Zero(), so = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d S = Eigen::Matrix3d::Zero();
+  double Srr = 0, Soo = 0;
+  AxisFit fit;
+  fit.n = p.for_each(d, [&](const Eigen::Vector3d& wr, const Eigen::Vector3d& wo, size_t) {
+    sr += wr;
+    so += wo;
+    S += wr * wo.transpose();
+    Srr += wr.squaredNorm();
+    Soo += wo.squaredNorm();
+  });
+  if (fit.n < 10) return fit;
+  const double n = static_cast<double>(fit.n);
+  const Eigen::Vector3d mr = sr / n, mo = so / n;
+  const Eigen::Matrix3d C = S - n * mr * mo.transpose();
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(C, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
+  if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0) D(2, 2) = -1;
+  fit.R = svd.matrixU() * D * svd.matrixV().transpose();
+  fit.b = mr - fit.R * mo;
+  // SSE = sum |wr - mr|^2 + |wo - mo|^2 - 2 tr(R^T C).
+  const double var_r = Srr - n * mr.squaredNorm(), var_o = Soo - n * mo.squaredNorm();
+  fit.sse = std::max(0.0, var_r + var_o - 2.0 * (fit.R.transpose() * C).trace());
+  return fit;
+}
+
+// The lag-1 autocorrelation of a residual sequence, clamped to [0, 0.99].
+double lag1_correlation(const std::vector<double>& r) {
+  if (r.size() < 3) return 0.0;
+  double mean = 0;
+  for (double x : r) mean += x;
+  mean /= static_cast<double>(r.size());
+  double c0 = 0, c1 = 0;
+  for (size_t i = 0; i < r.size(); ++i) {
+    c0 += (r[i] - mean) * (r[i] - mean);
+    if (i > 0) c1 += (r[i] - mean) * (r[i - 1] - mean);
+  }
+  return c0 > 0 ? std::clamp(c1 / c0, 0.0, 0.99) : 0.0;
+}
+
+// Formal 1-sigma of d from the residuals of the final model at d and their derivative in d,
+// inflated for residuals correlated in time (AR(1): n_eff = n (1 - rho) / (1 + rho)).
+double formal_sigma(const Pairing& p, double d, bool three_axis, const AxisFit& fit, double eps) {
+  // The norm model: |w_ref| = alpha |w_other| + beta.
+  double alpha = 1, beta = 0;
+  if (!three_axis) {
+    double n = 0, Sx = 0, Sy = 0, Sxx = 0, Sxy = 0;
+    p.for_each(d, [&](const Eigen::Vector3d& wr, const Eigen::Vector3d& wo, size_t) {
+      const double x = wo.norm(), y = wr.norm();
+      n += 1, Sx += x, Sy += y, Sxx += x * x, Sxy += x * y;
+    });
+    alpha = (n * Sxy - Sx * Sy) / (n * Sxx - Sx * Sx);
+    beta = (Sy - alpha * Sx) / n;
+  }
+  // Residuals per evaluation point at d, d + eps and d - eps; points missing at any of the
+  // three (at the ends of the overlap) are left out.
+  auto residuals = [&](double dd) {
+    std::vector<std::optional<Eigen::Vector3d>> r(p.points.size());
+    p.for_each(dd, [&](const Eigen::Vector3d& wr, const Eigen::Vector3d& wo, size_t q) {
+      r[q] = three_axis ? Eigen::Vector3d(wr - fit.R * wo - fit.b)
+                        : Eigen::Vector3d(wr.norm() - alpha * wo.norm() - beta, 0, 0);
+    });
+    return r;
+  };
+  const auto r0 = residuals(d), rp = residuals(d + eps), rm = residuals(d - eps);
+  const int dims = three_axis ? 3 : 1;
+  double sse = 0, jtj = 0;
+  size_t n = 0;
+  std::vector<double> seq[3];
+  for (size_t i = 0; i < r0.size(); ++i) {
+    if (!r0[i] || !rp[i] || !rm[i]) continue;
+    const Eigen::Vector3d J = (*rp[i] - *rm[i]) / (2 * eps);
+    for (int c = 0; c < dims; ++c) {
+      sse += (*r0[i])[c] * (*r0[i])[c];
+      jtj += J[c] * J[c];
+      seq[c].push_back((*r0[i])[c]);
+    }
+    ++n;
+  }
+  if (n < 10) return NAN;
+  double rho = 0;
+  for (int c = 0; c < dims; ++c) rho += lag1_correlation(seq[c]) / dims;
+  const double dof = static_cast<double>(dims * n) - (three_axis ? 7.0 : 3.0);
+  const double sigma2 = sse / dof;
+  return std::sqrt(sigma2 / jtj * (1 + rho) / (1 - rho));
+}
+
+double stddev_of_norm(const Series& s) {
+  double sum = 0, sum2 = 0;
+  for (const Eigen::Vector3d& w : s.w) {
+    sum += w.norm();
+    sum2 += w.squaredNorm();
+  }
+  const double n = static_cast<double>(s.w.size());
+  return std::sqrt(std::max(0.0, sum2 / n - (sum / n) * (sum / n)));
+}
+
+struct Refined {
+  double integer_d = NAN, parabolic_d = NAN, norm_d = NAN, d = NAN, peak = NAN;
+  AxisFit fit;
+  bool at_edge = false;
+  std::vector<CorrelationPoint> curve;
+};
+
+// From a first guess d0: the fine-grid correlation over d0 +- half_range, its integer peak, the
+// parabola, the continuous norm refinement and (optionally) the three-axis refinement.
+Refined refine(const Grid& fa, const Grid& fb, double h, const Pairing& p, double d0,
+               double half_range, bool three_axis, size_t min_count) {
+  Refined out;
+  const long k0 = std::lround((d0 - half_range) / h), k1 = std::lround((d0 + half_range) / h);
+  long best = k0;
+  std::vector<double> ncc;
+  for (long k = k0; k <= k1; ++k) {
+    size_t count = 0;
+    double c = masked_ncc_direct(fa, fb, k, count);
+    if (count < min_count) c = NAN;
+    ncc.push_back(c);
+    out.curve.push_back({k * h, c});
+    if (!std::isnan(c) && (std::isnan(ncc[best - k0]) || c > ncc[best - k0])) best = k;
+  }
+  if (std::isnan(ncc[best - k0])) return out;
+  out.peak = ncc[best - k0];
+  out.integer_d = best * h;
+  out.at_edge = best == k0 || best == k1;
+  double frac = 0;
+  if (!out.at_edge) frac = parabola_vertex(ncc[best - k0 - 1], ncc[best - k0], ncc[best - k0 + 1]);
+  out.parabolic_d = (best + frac) * h;
+  out.norm_d = golden_minimize([&](double d) { return -norm_ncc(p, d); }, out.parabolic_d - h,
+                               out.parabolic_d + h, 1e-7);
+  out.d = out.norm_d;
+  if (three_axis) {
+    out.d = golden_minimize([&](double d) { return fit_axes(p, d).sse; }, out.norm_d - h,
+                            out.norm_d + h, 1e-7);
+  }
+  out.fit = fit_axes(p, out.d);
+  return out;
+}
+
+Pairing make_pairing(const Series& ref, const Series& other) {
+  Pairing p;
+  p.slow_is_reference = ref.median_dt >= other.median_dt;
+  p.slow = p.slow_is_reference ? &ref : &other;
+  p.fast = p.slow_is_reference ? &other : &ref;
+  return p;
+}
+
+}  // namespace
+
+AngularRates angular_rates_from_trajectory(const Trajectory& traj) {
+  AngularRates out;
+  std::vector<double> dts;
+  for (size_t k = 0; k + 1 < traj.T_world_body.size(); ++k) {
+    const Time dt = traj.stamps[k + 1] - traj.stamps[k];
+    if (dt.ns <= 0) continue;
+    const Eigen::Matrix3d dR = traj.T_world_body[k].R.transpose() * traj.T_world_body[k + 1].R;
+    out.stamps.push_back(traj.stamps[k] + Time::from_ns(dt.ns / 2));
+    out.rates.push_back(rotation_vector(dR) / dt.seconds());
+    dts.push_back(dt.seconds());
+  }
+  out.averaging_s = dts.empty() ? 0.0 : median(dts);
+  return out;
+}
+
+size_t merge_equal_stamps(AngularRates& r) {
+  size_t merged = 0, out = 0;
+  for (size_t k = 0; k < r.stamps.size();) {
+    if (k > 0 && r.stamps[k] < r.stamps[k - 1]) {
+      throw Error(fmt::format("stamps go backwards at sample {} ({} after {})", k,
+                              to_seconds_text(r.stamps[k]), to_seconds_text(r.stamps[k - 1])));
+    }
+    size_t e = k + 1;
+    Eigen::Vector3d sum = r.rates[k];
+    while (e < r.stamps.size() && r.stamps[e] == r.stamps[k]) sum += r.rates[e++];
+    r.stamps[out] = r.stamps[k];
+    r.rates[out] = sum / static_cast<double>(e - k);
+    merged += e - k - 1;
+    ++out;
+    k = e;
+  }
+  r.stamps.resize(out);
+  r.rates.resize(out);
+  return merged;
+}
+
+TimeSyncResult estimate_time_offset(const AngularRates& reference_in, const AngularRates& other_in,
+                                    const TimeSyncOptions& opt) {
+  TimeSyncResult res;
+  if (reference_in.stamps.empty() || other_in.stamps.empty())
+    throw Error("both streams need samples");
+  const Time epoch_ref = reference_in.stamps.front();
+  res.epoch = other_in.stamps.front();
+  Series ref = make_series(reference_in, epoch_ref, "reference");
+  Series oth = make_series(other_in, epoch_ref, "other");
+  const double epoch_other_s = (res.epoch - epoch_ref).seconds();
+  res.reference_rate_hz = ref.rate_hz();
+  res.other_rate_hz = oth.rate_hz();
+  // Match bandwidths: an instantaneous stream is box-filtered to the other's averaging.
+  if (ref.averaging_s < oth.averaging_s) ref = box_filter(ref, oth.averaging_s);
+  if (oth.averaging_s < ref.averaging_s) oth = box_filter(oth, ref.averaging_s);
+  auto fail = [&](std::string verdict, std::string reason) {
+    res.verdict = std::move(verdict);
+    res.reason = std::move(reason);
+    res.offset_s = res.sigma_s = NAN;
+    return res;
+  };
+  res.excitation_reference_rad_s = stddev_of_norm(ref);
+  res.excitation_other_rad_s = stddev_of_norm(oth);
+  if (std::min(res.excitation_reference_rad_s, res.excitation_other_rad_s) <
+      opt.min_excitation_rad_s) {
+    return fail("not enough excitation",
+                fmt::format("the angular rate's norm varies by {:.4f} rad/s (reference) and {:.4f} "
+                            "rad/s (other), 1-sigma; at least {} is needed: rotate the sensors "
+                            "back and forth about changing axes, not at a constant rate",
+                            res.excitation_reference_rad_s, res.excitation_other_rad_s,
+                            opt.min_excitation_rad_s));
+  }
+  const double span = std::min(ref.t.back() - ref.t.front(), oth.t.back() - oth.t.front());
+  const double min_overlap_s = opt.min_overlap * span;
+
+  // Coarse pass: FFT over every lag, both streams box-filtered to the coarse step.
+  res.coarse_hz = std::min(opt.coarse_hz, std::max(res.reference_rate_hz, res.other_rate_hz));
+  const double hc = 1.0 / res.coarse_hz;
+  const Series ref_c = ref.averaging_s < hc ? box_filter(ref, hc) : ref;
+  const Series oth_c = oth.averaging_s < hc ? box_filter(oth, hc) : oth;
+  const Grid ga = norm_grid(ref_c, hc), gb = norm_grid(oth_c, hc);
+  if (ga.v.size() < 3 || gb.v.size() < 3) return fail("no overlap", "the streams are too short");
+  long k_first = 0;
+  const std::vector<double> coarse =
+      masked_ncc_fft(ga, gb, static_cast<size_t>(min_overlap_s / hc), k_first);
+  long best = -1;
+  const long k_lo =
+      std::isfinite(opt.max_offset_s) ? std::lround(-opt.max_offset_s / hc) : LONG_MIN;
+  const long k_hi = std::isfinite(opt.max_offset_s) ? std::lround(opt.max_offset_s / hc) : LONG_MAX;
+  std::vector<long> valid;
+  for (size_t i = 0; i < coarse.size(); ++i) {
+    const long k = k_first + static_cast<long>(i);
+    if (k < k_lo || k > k_hi || std::isnan(coarse[i])) continue;
+    valid.push_back(static_cast<long>(i));
+    if (best < 0 || coarse[i] > coarse[best]) best = static_cast<long>(i);
+  }
+  if (best < 0) {
+    return fail(
+        "no overlap",
+        fmt::format("no offset within +-{} s leaves {:.1f} s of overlap (half the shorter "
+                    "stream); the reference spans [{:.3f}, {:.3f}] s and the other [{:.3f}, "
+                    "{:.3f}] s of stamps: widen the search (--max-offset)",
+                    opt.max_offset_s, min_overlap_s, ref.t.front(), ref.t.back(), oth.t.front(),
+                    oth.t.back()));
+  }
+  for (long i : valid) res.coarse_curve.push_back({(k_first + i) * hc, coarse[i]});
+  res.coarse_offset_s = (k_first + best) * hc;
+  res.peak_ncc = coarse[best];
+  // The main lobe: from the peak outwards while the correlation keeps falling.
+  long lo = best, hi = best;
+  auto ok = [&](long i) {
+    const long k = k_first + i;
+    return i >= 0 && i < static_cast<long>(coarse.size()) && k >= k_lo && k <= k_hi &&
+           !std::isnan(coarse[i]);
+  };
+  while (ok(lo - 1) && coarse[lo - 1] <= coarse[lo]) --lo;
+  while (ok(hi + 1) && coarse[hi + 1] <= coarse[hi]) ++hi;
+  res.second_peak_ncc = -1;
+  for (long i : valid) {
+    if (i >= lo && i <= hi) continue;
+    const bool local_max =
+        (!ok(i - 1) || coarse[i - 1] <= coarse[i]) && (!ok(i + 1) || coarse[i + 1] <= coarse[i]);
+    if (local_max && coarse[i] > res.second_peak_ncc) {
+      res.second_peak_ncc = coarse[i];
+      res.second_peak_offset_s = (k_first + i) * hc;
+    }
+  }
+  res.peak_ratio = res.second_peak_ncc > 0 ? res.second_peak_ncc / res.peak_ncc : 0.0;
+  res.overlap_s = std::min(ref.t.back(), oth.t.back() + res.coarse_offset_s) -
+                  std::max(ref.t.front(), oth.t.front() + res.coarse_offset_s);
+  if (!ok(best - 1) || !ok(best + 1)) {
+    return fail("peak at the edge",
+                fmt::format("the best correlation ({:.3f}) is at the edge of the search range, "
+                            "offset {:.3f} s: the true offset may lie outside; widen --max-offset",
+                            res.peak_ncc, res.coarse_offset_s));
+  }
+  if (res.peak_ncc < opt.min_peak_ncc) {
+    return fail("poor correlation",
+                fmt::format("the best normalized correlation is {:.3f} (at {:.3f} s), below {}: "
+                            "the streams do not seem to see the same motion",
+                            res.peak_ncc, res.coarse_offset_s, opt.min_peak_ncc));
+  }
+  if (res.peak_ratio > opt.max_peak_ratio) {
+    return fail(
+        "ambiguous",
+        fmt::format("a second correlation peak at {:.3f} s reaches {:.3f} against {:.3f} at "
+                    "{:.3f} s (ratio {:.2f}): the motion is too periodic to tell the offset; "
+                    "record less regular motion or narrow --max-offset",
+                    res.second_peak_offset_s, res.second_peak_ncc, res.peak_ncc,
+                    res.coarse_offset_s, res.peak_ratio));
+  }
+
+  // Fine pass and continuous refinement.
+  res.grid_hz = std::min(opt.fine_hz_max, std::max(res.reference_rate_hz, res.other_rate_hz));
+  const double hf = 1.0 / res.grid_hz;
+  const Grid fa = norm_grid(ref, hf), fb = norm_grid(oth, hf);
+  Pairing p = make_pairing(ref, oth);
+  for (size_t i = 0; i < p.slow->t.size(); ++i) p.points.push_back(i);
+  const size_t min_fine = static_cast<size_t>(min_overlap_s / hf);
+  const Refined r = refine(fa, fb, hf, p, res.coarse_offset_s, 3 * hc, opt.three_axis, min_fine);
+  if (std::isnan(r.d)) return fail("no overlap", "the fine correlation found no overlap");
+  res.integer_offset_s = r.integer_d;
+  res.parabolic_offset_s = r.parabolic_d;
+  res.norm_offset_s = r.norm_d;
+  res.fine_curve = r.curve;
+  res.three_axis = opt.three_axis;
+  res.R_reference_other = r.fit.R;
+  res.bias_difference = r.fit.b;
+  res.samples_used = r.fit.n;
+  res.residual_rms_rad_s = std::sqrt(r.fit.sse / (3.0 * r.fit.n));
+  res.sigma_formal_s = formal_sigma(p, r.d, opt.three_axis, r.fit, 0.1 * hf);
+  res.mean_offset_s = r.d;
+
+  // Drift: offsets in half-overlapping windows along the other stream.
+  const double t0 = std::max(ref.t.front() - r.d, oth.t.front());
+  const double t1 = std::min(ref.t.back() - r.d, oth.t.back());
+  res.window_s = opt.window_s > 0 ? opt.window_s : std::max(20.0, (t1 - t0) / 8.0);
+  const double W = res.window_s;
+  for (double ws = t0; ws + W <= t1 + 1e-9; ws += 0.5 * W) {
+    WindowOffset wo;
+    wo.t_other_s = ws + 0.5 * W - epoch_other_s;
+    // The window's samples, in both streams (the other clock).
+    Series rw, ow;
+    for (size_t i = 0; i < ref.t.size(); ++i) {
+      if (ref.t[i] - r.d >= ws - 0.2 && ref.t[i] - r.d <= ws + W + 0.2) {
+        rw.t.push_back(ref.t[i]);
+        rw.w.push_back(ref.w[i]);
+      }
+    }
+    for (size_t i = 0; i < oth.t.size(); ++i) {
+      if (oth.t[i] >= ws && oth.t[i] <= ws + W) {
+        ow.t.push_back(oth.t[i]);
+        ow.w.push_back(oth.w[i]);
+      }
+    }
+    for (Series* s : {&rw, &ow}) {
+      s->median_dt = (s == &rw ? ref : oth).median_dt;
+      s->gap_s = (s == &rw ? ref : oth).gap_s;
+    }
+    if (rw.t.size() < 20 || ow.t.size() < 20) {
+      wo.note = "too few samples";
+      res.windows.push_back(wo);
+      continue;
+    }
+    if (std::min(stddev_of_norm(rw), stddev_of_norm(ow)) < opt.min_excitation_rad_s) {
+      wo.note = "not enough excitation";
+      res.windows.push_back(wo);
+      continue;
+    }
+    const Grid wa = norm_grid(rw, hf), wb = norm_grid(ow, hf);
+    Pairing wp = make_pairing(rw, ow);
+    for (size_t i = 0; i < wp.slow->t.size(); ++i) wp.points.push_back(i);
+    const Refined wr = refine(wa, wb, hf, wp, r.d, std::min(0.1, 3 * hc), opt.three_axis,
+                              static_cast<size_t>(0.8 * W / hf));
+    wo.ncc = wr.peak;
+    if (std::isnan(wr.d) || wr.at_edge || !(wr.peak >= opt.min_peak_ncc)) {
+      wo.note =
+          std::isnan(wr.d) ? "no overlap" : (wr.at_edge ? "peak at the edge" : "poor correlation");
+      res.windows.push_back(wo);
+      continue;
+    }
+    wo.offset_s = wr.d;
+    wo.sigma_s = formal_sigma(wp, wr.d, opt.three_axis, wr.fit, 0.1 * hf);
+    wo.used = true;
+    res.windows.push_back(wo);
+  }
+  // Linear fit offset = o0 + drift * t (other clock, seconds since the epoch), one pass of
+  // outlier rejection (5 x 1.4826 MAD).
+  auto fit_line = [&](double& o0, double& s, double& sd_o0, double& sd_s, double& rms) {
+    double n = 0, St = 0, So = 0, Stt = 0, Sto = 0;
+    for (const WindowOffset& w : res.windows) {
+      if (!w.used) continue;
+      n += 1, St += w.t_other_s, So += w.offset_s, Stt += w.t_other_s * w.t_other_s,
+          Sto += w.t_other_s * w.offset_s;
+    }
+    const double det = n * Stt - St * St;
+    s = (n * Sto - St * So) / det;
+    o0 = (So - s * St) / n;
+    double sse = 0;
+    for (const WindowOffset& w : res.windows) {
+      if (w.used) sse += std::pow(w.offset_s - o0 - s * w.t_other_s, 2);
+    }
+    const double sigma2 = n > 2 ? sse / (n - 2) : NAN;
+    rms = std::sqrt(sse / n);
+    // Half-overlapping windows are not independent: variances doubled.
+    sd_s = std::sqrt(2 * sigma2 * n / det);
+    sd_o0 = std::sqrt(2 * sigma2 * Stt / det);
+    return n;
+  };
+  size_t used = 0;
+  for (const WindowOffset& w : res.windows) used += w.used;
+  if (used >= 4) {
+    double o0, s, sd_o0, sd_s, rms;
+    fit_line(o0, s, sd_o0, sd_s, rms);
+    std::vector<double> dev;
+    for (const WindowOffset& w : res.windows) {
+      if (w.used) dev.push_back(std::abs(w.offset_s - o0 - s * w.t_other_s));
+    }
+    const double mad = 1.4826 * median(dev);
+    for (WindowOffset& w : res.windows) {
+      if (w.used && std::abs(w.offset_s - o0 - s * w.t_other_s) > std::max(5 * mad, 1e-6)) {
+        w.used = false;
+        w.note = "outlier in the drift fit";
+      }
+    }
+    used = 0;
+    for (const WindowOffset& w : res.windows) used += w.used;
+  }
+  if (used >= 4) {
+    double o0, s, sd_o0, sd_s, rms;
+    fit_line(o0, s, sd_o0, sd_s, rms);
+    res.drift_estimated = true;
+    res.drift_ppm = s * 1e6;
+    res.drift_sigma_ppm = sd_s * 1e6;
+    res.window_residual_rms_s = rms;
+    res.drift_significant = std::abs(s) > 3 * sd_s;
+    // Without drift, the windows' spread says how well the mean offset is known.
+    double mean = 0, var = 0;
+    for (const WindowOffset& w : res.windows) mean += w.used ? w.offset_s / used : 0.0;
+    for (const WindowOffset& w : res.windows)
+      var += w.used ? (w.offset_s - mean) * (w.offset_s - mean) / (used - 1) : 0.0;
+    res.sigma_windows_s = std::sqrt(2 * var / used);
+    if (res.drift_significant) {
+      res.offset_s = o0;
+      res.sigma_s = std::max(sd_o0, res.sigma_formal_s);
+      return res;
+    }
+  }
+  res.offset_s = r.d;
+  res.sigma_s = std::max(res.sigma_formal_s, res.sigma_windows_s);
+  return res;
+}
+
+}  // namespace rigcal::time_sync
