@@ -35,6 +35,12 @@ void print_rig(const std::string& file, const rig::Rig& r) {
                s.name, rig::to_string(s.type), t.x(), t.y(), t.z(), rpy.x(), rpy.y(), rpy.z(),
                s.time_offset * 1e3);
   }
+  for (const rig::Sensor& s : r.sensors) {
+    if (s.time_drift_ppm) {
+      fmt::print("  {}: clock drift {:.3f} ppm from {} s on its clock\n", s.name, *s.time_drift_ppm,
+                 to_seconds_text(s.time_drift_epoch));
+    }
+  }
   const std::vector<const rig::Sensor*> cams = rig::cameras(r);
   if (!cams.empty()) {
     fmt::print("\nCameras (pinhole; px):\n");

@@ -101,6 +101,10 @@ std::vector<Problem> find_problems(const Rig& rig) {
     if (std::string what = check_rotation(s.T_base_sensor.R); !what.empty()) add("T_b", what);
     if (!s.T_base_sensor.t.allFinite()) add("T_b", "translation must be finite");
     if (!std::isfinite(s.time_offset)) add("time_offset", "must be a finite number of seconds");
+    if (s.time_drift_ppm && !(std::abs(*s.time_drift_ppm) < 1e4)) {
+      add("time_drift_ppm",
+          fmt::format("must be finite and below 1e4 ppm, got {}", *s.time_drift_ppm));
+    }
     if (s.update_rate && !(*s.update_rate > 0)) {
       add("update_rate", fmt::format("must be > 0 Hz, got {}", *s.update_rate));
     }

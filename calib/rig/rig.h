@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "rigcal/core/se3.h"
+#include "rigcal/core/time.h"
 
 namespace rigcal::rig {
 
@@ -52,6 +53,10 @@ struct Sensor {
   SE3 T_base_sensor;
   // Seconds added to this sensor's stamps to put them on the base clock.
   double time_offset = 0.0;
+  // Clock drift, where measured: t_base = t + time_offset + time_drift_ppm * 1e-6 * (t - epoch),
+  // t and epoch on this sensor's clock.
+  std::optional<double> time_drift_ppm;
+  Time time_drift_epoch;
   std::optional<double> update_rate;  // Hz, where known
   std::string model;                  // free text: "OS0-128", "Ellipse-E" ...
 

@@ -28,6 +28,8 @@ const std::set<std::string> kKnownKeys = {"sensor_type",
                                           "resolution",
                                           "T_b",
                                           "time_offset",
+                                          "time_drift_ppm",
+                                          "time_drift_epoch",
                                           "update_rate",
                                           "model",
                                           "frame",
@@ -161,6 +163,18 @@ Sensor read_sensor(Reader& r, const std::string& name, const YAML::Node& node, b
 
   s.T_base_sensor = SE3::from_matrix(r.matrix4(require("T_b"), key_of("T_b")));
   if (const YAML::Node n = node["time_offset"]) s.time_offset = r.number(n, key_of("time_offset"));
+  if (const YAML::Node n = node["time_drift_ppm"]) {
+    s.time_drift_ppm = r.number(n, key_of("time_drift_ppm"));
+    const YAML::Node e = node["time_drift_epoch"];
+    if (!e) r.fail(n, key_of("time_drift_ppm"), "needs time_drift_epoch (s, this sensor's clock)");
+    try {
+      s.time_drift_epoch = parse_seconds(r.text(e, key_of("time_drift_epoch")));
+    } catch (const Error& err) {
+      r.fail(e, key_of("time_drift_epoch"), err.what());
+    }
+  } else if (const YAML::Node e = node["time_drift_epoch"]) {
+    r.fail(e, key_of("time_drift_epoch"), "given without time_drift_ppm");
+  }
   if (const YAML::Node n = node["update_rate"]) s.update_rate = r.number(n, key_of("update_rate"));
   if (const YAML::Node n = node["model"]) s.model = r.text(n, key_of("model"));
 
@@ -312,6 +326,10 @@ std::string sensors_yaml(const Rig& rig, bool full) {
     }
     out += "  T_b:\n" + yaml_matrix4_rows(s.T_base_sensor, "    ");
     if (full) out += fmt::format("  time_offset: {}\n", yaml_number(s.time_offset));
+    if (full && s.time_drift_ppm) {
+      out += fmt::format("  time_drift_ppm: {}\n  time_drift_epoch: {}\n",
+                         yaml_number(*s.time_drift_ppm), to_seconds_text(s.time_drift_epoch));
+    }
     if (s.type == SensorType::imu) {
       const std::optional<double>* fields[] = {
           &s.imu.gyroscope_noise_density, &s.imu.gyroscope_random_walk,
