@@ -755,8 +755,10 @@ TimeSyncResult estimate_time_offset(const AngularRates& reference_in, const Angu
       var += w.used ? (w.offset_s - mean) * (w.offset_s - mean) / (used - 1) : 0.0;
     res.sigma_windows_s = std::sqrt(2 * var / used);
     if (res.drift_significant) {
+      // The whole-overlap formal sigma assumes a constant offset; with drift the line's own
+      // intercept uncertainty is the figure.
       res.offset_s = o0;
-      res.sigma_s = std::max(sd_o0, res.sigma_formal_s);
+      res.sigma_s = sd_o0;
       return res;
     }
   }
