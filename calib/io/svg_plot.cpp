@@ -4,7 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
+#include <opencv2/imgproc.hpp>
+
+#include "rigcal/io/png.h"
 
 namespace rigcal::io {
 namespace {
@@ -50,9 +54,13 @@ double nice_step(double range, int target) {
   return 10 * mag;
 }
 
-}  // namespace
+// The data bounds of a plot (x0..x1, y0..y1) and of its colour values (v0..v1), widened where
+// degenerate and made equal-scaled when the plot asks for it.
+struct Bounds {
+  double x0, x1, y0, y1, v0, v1, sx, sy;
+};
 
-std::string render_svg(const Plot& plot) {
+Bounds bounds(const Plot& plot, double pw, double ph) {
   double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
   double v0 = x0, v1 = -x0;
   for (const PlotSeries& s : plot.series) {
@@ -68,7 +76,6 @@ std::string render_svg(const Plot& plot) {
   if (!std::isfinite(x0)) x0 = 0, x1 = 1, y0 = 0, y1 = 1;
   if (x1 - x0 < 1e-12) x0 -= 0.5, x1 += 0.5;
   if (y1 - y0 < 1e-12) y0 -= 0.5, y1 += 0.5;
-  const double pw = kW - kLeft - kRight, ph = kH - kTop - kBottom;
   double sx = pw / (x1 - x0), sy = ph / (y1 - y0);
   if (plot.equal_axes) {
     const double s = std::min(sx, sy);
@@ -77,6 +84,14 @@ std::string render_svg(const Plot& plot) {
     x0 = cx - pw / (2 * s), x1 = cx + pw / (2 * s);
     y0 = cy - ph / (2 * s), y1 = cy + ph / (2 * s);
   }
+  return {x0, x1, y0, y1, v0, v1, sx, sy};
+}
+
+}  // namespace
+
+std::string render_svg(const Plot& plot) {
+  const double pw = kW - kLeft - kRight, ph = kH - kTop - kBottom;
+  const auto [x0, x1, y0, y1, v0, v1, sx, sy] = bounds(plot, pw, ph);
   auto X = [&](double x) { return kLeft + (x - x0) * sx; };
   auto Y = [&](double y) { return kTop + ph - (y - y0) * sy; };
 
@@ -162,6 +177,68 @@ std::string render_svg(const Plot& plot) {
   }
   out += "</svg>\n";
   return out;
+}
+
+}  // namespace rigcal::io
+
+namespace rigcal::io {
+
+std::string render_png(const Plot& plot) {
+  const double pw = kW - kLeft - kRight, ph = kH - kTop - kBottom;
+  const auto [x0, x1, y0, y1, v0, v1, sx, sy] = bounds(plot, pw, ph);
+  auto X = [&](double x) { return kLeft + (x - x0) * sx; };
+  auto Y = [&](double y) { return kTop + ph - (y - y0) * sy; };
+  auto P = [](double x, double y) { return cv::Point(cvRound(x), cvRound(y)); };
+  cv::Mat img(static_cast<int>(kH), static_cast<int>(kW), CV_8UC3, cv::Scalar(255, 255, 255));
+  const int font = cv::FONT_HERSHEY_SIMPLEX;
+  auto text = [&](const std::string& t, double x, double y, double scale, int align) {
+    int base = 0;
+    const cv::Size size = cv::getTextSize(t, font, scale, 1, &base);
+    const double left = align == 0 ? x : (align == 1 ? x - size.width / 2.0 : x - size.width);
+    cv::putText(img, t, P(left, y), font, scale, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  };
+  text(plot.title, kLeft + pw / 2, 30, 0.6, 1);
+  const double xs = nice_step(x1 - x0, 8), ys = nice_step(y1 - y0, 8);
+  for (double x = std::ceil(x0 / xs) * xs; x <= x1 + 1e-9 * xs; x += xs) {
+    cv::line(img, P(X(x), kTop), P(X(x), kTop + ph), cv::Scalar(224, 224, 224));
+    text(fmt::format("{:g}", std::abs(x) < 1e-12 * xs ? 0.0 : x), X(x), kTop + ph + 18, 0.4, 1);
+  }
+  for (double y = std::ceil(y0 / ys) * ys; y <= y1 + 1e-9 * ys; y += ys) {
+    cv::line(img, P(kLeft, Y(y)), P(kLeft + pw, Y(y)), cv::Scalar(224, 224, 224));
+    text(fmt::format("{:g}", std::abs(y) < 1e-12 * ys ? 0.0 : y), kLeft - 6, Y(y) + 4, 0.4, 2);
+  }
+  cv::rectangle(img, P(kLeft, kTop), P(kLeft + pw, kTop + ph), cv::Scalar(0, 0, 0));
+  text(plot.x_label, kLeft + pw / 2, kH - 18, 0.45, 1);
+  text(plot.y_label, 8, kTop - 12, 0.45, 0);
+  // Series, clipped to the plot area; colours as in the SVG (BGR).
+  cv::Mat area = img(cv::Rect(static_cast<int>(kLeft), static_cast<int>(kTop), static_cast<int>(pw),
+                              static_cast<int>(ph)));
+  auto colour = [](size_t k) {
+    unsigned v = 0;
+    std::sscanf(kPalette[k % 10] + 1, "%x", &v);
+    return cv::Scalar(v & 0xff, (v >> 8) & 0xff, (v >> 16) & 0xff);
+  };
+  for (size_t k = 0; k < plot.series.size(); ++k) {
+    const PlotSeries& s = plot.series[k];
+    std::vector<cv::Point> pts;
+    for (size_t i = 0; i < s.x.size(); ++i) {
+      if (std::isfinite(s.x[i]) && std::isfinite(s.y[i]))
+        pts.push_back(P(X(s.x[i]) - kLeft, Y(s.y[i]) - kTop));
+    }
+    if (!s.values.empty()) {
+      for (size_t i = 0; i < pts.size(); ++i) cv::circle(area, pts[i], 2, colour(k), cv::FILLED);
+    } else if (pts.size() > 1) {
+      cv::polylines(area, pts, false, colour(k), 1, cv::LINE_AA);
+    }
+  }
+  double ly = kTop + 10;
+  for (size_t k = 0; k < plot.series.size(); ++k) {
+    if (plot.series[k].label.empty()) continue;
+    cv::line(img, P(kW - kRight + 10, ly), P(kW - kRight + 30, ly), colour(k), 3);
+    text(plot.series[k].label, kW - kRight + 35, ly + 4, 0.4, 0);
+    ly += 18;
+  }
+  return encode_png(img);
 }
 
 }  // namespace rigcal::io

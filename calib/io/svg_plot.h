@@ -21,5 +21,7 @@ struct Plot {
 };
 
 std::string render_svg(const Plot& plot);
+// The same plot as PNG bytes (lines and points; no colour bar), for reports that ask for PNG.
+std::string render_png(const Plot& plot);
 
 }  // namespace rigcal::io
