@@ -512,8 +512,11 @@ size_t merge_equal_stamps(AngularRates& r) {
   return merged;
 }
 
-TimeSyncResult estimate_time_offset(const AngularRates& reference_in, const AngularRates& other_in,
-                                    const TimeSyncOptions& opt) {
+namespace {
+
+// One pass: the offset over the whole overlap, then the windows and the drift line.
+TimeSyncResult estimate_pass(const AngularRates& reference_in, const AngularRates& other_in,
+                             const TimeSyncOptions& opt) {
   TimeSyncResult res;
   if (reference_in.stamps.empty() || other_in.stamps.empty())
     throw Error("both streams need samples");
@@ -732,7 +735,10 @@ TimeSyncResult estimate_time_offset(const AngularRates& reference_in, const Angu
     }
     const double mad = 1.4826 * median(dev);
     for (WindowOffset& w : res.windows) {
-      if (w.used && std::abs(w.offset_s - o0 - s * w.t_other_s) > std::max(5 * mad, 1e-6)) {
+      // A window is an outlier beyond 5 MAD of the line, but never within 4 of its own sigma
+      // (windows agreeing to a microsecond would otherwise reject their own noise).
+      const double limit = std::max({5 * mad, 4 * w.sigma_s, 1e-6});
+      if (w.used && std::abs(w.offset_s - o0 - s * w.t_other_s) > limit) {
         w.used = false;
         w.note = "outlier in the drift fit";
       }
@@ -764,6 +770,36 @@ TimeSyncResult estimate_time_offset(const AngularRates& reference_in, const Angu
   }
   res.offset_s = r.d;
   res.sigma_s = std::max(res.sigma_formal_s, res.sigma_windows_s);
+  return res;
+}
+
+}  // namespace
+
+TimeSyncResult estimate_time_offset(const AngularRates& reference, const AngularRates& other,
+                                    const TimeSyncOptions& opt) {
+  TimeSyncResult first = estimate_pass(reference, other, opt);
+  if (first.verdict != "ok" || !first.drift_significant) return first;
+  // With drift, a window's offset is the mean of a changing offset weighted by where in the
+  // window the motion is: biased by up to drift x window / 2. Remove the drift from the other
+  // stamps, t' = t + s (t - epoch), and measure again: the second pass sees an almost constant
+  // offset, its windows are unbiased and its whole-overlap fit is meaningful again.
+  const double s = first.drift_ppm * 1e-6;
+  AngularRates warped = other;
+  for (Time& t : warped.stamps) t = t + Time::from_seconds(s * (t - first.epoch).seconds());
+  TimeSyncResult res = estimate_pass(reference, warped, opt);
+  if (res.verdict != "ok" || !res.drift_estimated) return first;
+  // t_ref = t' + o + s2 (t' - e) with t' - e = (1 + s)(t - e): drift s + s2 (1 + s).
+  const double residual = res.drift_ppm * 1e-6;
+  res.drift_ppm = 1e6 * (s + residual * (1 + s));
+  res.drift_significant = std::abs(res.drift_ppm) > 3 * res.drift_sigma_ppm;
+  if (!res.drift_significant) return first;  // only if the second pass undoes the first
+  for (WindowOffset& w : res.windows) {
+    w.t_other_s /= 1 + s;
+    if (std::isfinite(w.offset_s)) w.offset_s += s * w.t_other_s;
+  }
+  // The offset at the epoch: the second pass's line when its residual drift is significant,
+  // else its constant offset (the epoch is a fixed point of the warp).
+  res.mean_offset_s = first.mean_offset_s;
   return res;
 }
 

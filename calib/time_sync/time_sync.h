@@ -15,6 +15,7 @@
 // rotation and the gyro bias difference are estimated (Kabsch) and the offset is refined on all
 // three axes. Offsets in sliding windows give the drift by a linear fit.
 #include <Eigen/Core>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -59,7 +60,8 @@ struct TimeSyncOptions {
 
 struct WindowOffset {
   double t_other_s = 0.0;  // the window's centre, seconds since the epoch, other clock
-  double offset_s = 0.0, sigma_s = 0.0, ncc = 0.0;
+  double offset_s = NAN, sigma_s = NAN;  // NaN where the window gave no offset
+  double ncc = 0.0;
   bool used = false;  // in the drift fit
   std::string note;   // why not used
 };
