@@ -5,6 +5,12 @@
 
 namespace rigcal::cli {
 
+// Thrown by a subcommand that ends with a status other than 0, 2 or 1 after its message
+// (e.g. time-offset's 3: the data give no answer).
+struct Exit {
+  int status;
+};
+
 // `rigcal rig validate|show|convert`
 void add_rig_validate(CLI::App& rig);
 void add_rig_show(CLI::App& rig);
@@ -15,6 +21,8 @@ void add_bench(CLI::App& app);
 void add_simulate(CLI::App& app);
 // `rigcal cameras`
 void add_cameras(CLI::App& app);
+// `rigcal time-offset`
+void add_time_offset(CLI::App& app);
 // `rigcal target print`
 void add_target_print(CLI::App& target);
 

@@ -17,7 +17,9 @@ int main(int argc, char** argv) {
       "rigcal"};
   app.set_version_flag("--version", rigcal::version_string());
   app.require_subcommand(1);
-  app.footer("Exit status: 0 success, 2 bad input (the message names file, line and key), 1 bug.");
+  app.footer(
+      "Exit status: 0 success, 2 bad input (the message names file, line and key), 1 bug;\n"
+      "time-offset: 3 when the data give no offset.");
 
   CLI::App* rig = app.add_subcommand("rig", "Check, show and convert a calibration YAML");
   rig->require_subcommand(1);
@@ -27,6 +29,7 @@ int main(int argc, char** argv) {
   rigcal::cli::add_bench(app);
   rigcal::cli::add_simulate(app);
   rigcal::cli::add_cameras(app);
+  rigcal::cli::add_time_offset(app);
   CLI::App* target = app.add_subcommand("target", "Calibration targets: printable PDFs");
   target->require_subcommand(1);
   rigcal::cli::add_target_print(*target);
@@ -38,6 +41,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr, "rigcal: %s (see rigcal --help)\n", e.what());
     return 2;
+  } catch (const rigcal::cli::Exit& e) {
+    return e.status;
   } catch (const rigcal::Error& e) {
     std::fprintf(stderr, "rigcal: error: %s\n", e.what());
     return 2;

@@ -76,6 +76,10 @@ Bounds bounds(const Plot& plot, double pw, double ph) {
   if (!std::isfinite(x0)) x0 = 0, x1 = 1, y0 = 0, y1 = 1;
   if (x1 - x0 < 1e-12) x0 -= 0.5, x1 += 0.5;
   if (y1 - y0 < 1e-12) y0 -= 0.5, y1 += 0.5;
+  if (!plot.equal_axes) {  // a margin, so that points on the extremes are not cut by the frame
+    const double m = 0.03 * (y1 - y0);
+    y0 -= m, y1 += m;
+  }
   double sx = pw / (x1 - x0), sy = ph / (y1 - y0);
   if (plot.equal_axes) {
     const double s = std::min(sx, sy);
@@ -197,7 +201,7 @@ std::string render_png(const Plot& plot) {
     const double left = align == 0 ? x : (align == 1 ? x - size.width / 2.0 : x - size.width);
     cv::putText(img, t, P(left, y), font, scale, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
   };
-  text(plot.title, kLeft + pw / 2, 30, 0.6, 1);
+  text(plot.title, kLeft + pw / 2, 22, 0.6, 1);
   const double xs = nice_step(x1 - x0, 8), ys = nice_step(y1 - y0, 8);
   for (double x = std::ceil(x0 / xs) * xs; x <= x1 + 1e-9 * xs; x += xs) {
     cv::line(img, P(X(x), kTop), P(X(x), kTop + ph), cv::Scalar(224, 224, 224));
@@ -209,7 +213,7 @@ std::string render_png(const Plot& plot) {
   }
   cv::rectangle(img, P(kLeft, kTop), P(kLeft + pw, kTop + ph), cv::Scalar(0, 0, 0));
   text(plot.x_label, kLeft + pw / 2, kH - 18, 0.45, 1);
-  text(plot.y_label, 8, kTop - 12, 0.45, 0);
+  text(plot.y_label, 8, kTop - 8, 0.45, 0);
   // Series, clipped to the plot area; colours as in the SVG (BGR).
   cv::Mat area = img(cv::Rect(static_cast<int>(kLeft), static_cast<int>(kTop), static_cast<int>(pw),
                               static_cast<int>(ph)));

@@ -88,8 +88,8 @@ nlohmann::json time_sync_json(const TimeSyncResult& r, const time_sync::TimeSync
     nlohmann::json windows = nlohmann::json::array();
     for (const time_sync::WindowOffset& w : r.windows) {
       windows.push_back({{"t_other_s", w.t_other_s},
-                         {"offset_s", w.used ? number(w.offset_s) : nlohmann::json()},
-                         {"sigma_s", w.used ? number(w.sigma_s) : nlohmann::json()},
+                         {"offset_s", number(w.offset_s)},
+                         {"sigma_s", number(w.sigma_s)},
                          {"ncc", number(w.ncc)},
                          {"used", w.used},
                          {"note", w.note}});
@@ -169,9 +169,16 @@ std::vector<OutputFile> time_sync_report_files(
                     : "Windowed offsets (too few for a drift fit)";
       w.x_label = "other clock (s since the epoch)";
       w.y_label = "offset - final offset (ms)";
-      PlotSeries used{"used", {}, {}, {}}, fit{"drift fit", {}, {}, {}};
+      PlotSeries used{"used", {}, {}, {}}, fit{"drift fit", {}, {}, {}},
+          rejected{"outliers", {}, {}, {}};
       for (const time_sync::WindowOffset& x : r.windows) {
-        if (!x.used) continue;
+        if (!x.used) {
+          if (std::isfinite(x.offset_s)) {
+            rejected.x.push_back(x.t_other_s);
+            rejected.y.push_back(1e3 * (x.offset_s - r.offset_s));
+          }
+          continue;
+        }
         used.x.push_back(x.t_other_s);
         used.y.push_back(1e3 * (x.offset_s - r.offset_s));
         if (r.drift_significant) {
@@ -180,8 +187,10 @@ std::vector<OutputFile> time_sync_report_files(
         }
       }
       used.values.assign(used.x.size(), 0.0);  // points
+      rejected.values.assign(rejected.x.size(), 0.0);
       w.series = {used};
       if (!fit.x.empty()) w.series.push_back(fit);
+      if (!rejected.x.empty()) w.series.push_back(rejected);
       files.push_back({dir / "windows.png", render_png(w)});
     }
   }

@@ -364,3 +364,69 @@ TEST_F(Cli, CamerasOnASimulatedRawBayerSession) {
 }
 
 }  // namespace
+
+TEST_F(Cli, TimeOffsetWritesTheSensorsOffsetAndDrift) {
+  // A simulated session whose external IMU runs 20 ppm fast; the truth is the sample rig's
+  // time_offset of imu (-0.0031 s) at its first stamp.
+  const fs::path cfg = write("sim.yaml", "seed: 3\nimu_duration_s: 600\nimu: {drift_ppm: 20}\n");
+  const fs::path session = dir_ / "session";
+  ASSERT_EQ(
+      run("simulate --what imu --out " + session.string() + " --config " + cfg.string()).status, 0);
+  const std::string out = (dir_ / "out.yaml").string(), report = (dir_ / "rep").string();
+  CliRun r = run("time-offset --session " + session.string() + " --rig " + kSample + " --out " +
+                 out + " --report " + report);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(run("rig validate " + out).status, 0);
+  const nlohmann::json j = nlohmann::json::parse(slurp(fs::path(report) / "report.json"));
+  EXPECT_EQ(j["verdict"], "ok");
+  EXPECT_NEAR(j["sensor_time_offset_s"].get<double>(), -0.0031, 0.05e-3);
+  EXPECT_TRUE(j["drift"]["significant"].get<bool>());
+  EXPECT_NEAR(j["drift"]["drift_ppm"].get<double>(), 20.0, 2.0);
+  const std::string yaml = slurp(out);
+  EXPECT_NE(yaml.find("time_drift_ppm: "), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("time_drift_epoch: "), std::string::npos) << yaml;
+  for (const char* f : {"correlation.png", "aligned.png", "windows.png"})
+    EXPECT_TRUE(fs::exists(fs::path(report) / f)) << f;
+
+  // The same rig measured again without drift: the drift keys go away.
+  const fs::path still = dir_ / "still";
+  ASSERT_EQ(run("simulate --what imu --out " + still.string()).status, 0);
+  r = run("time-offset --session " + still.string() + " --rig " + out + " --out " + out);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(slurp(out).find("time_drift_ppm"), std::string::npos);
+
+  // Still sensors: no number, exit 3, the report says why, the rig is not written.
+  const std::string imu_table = "t wx wy wz\n";
+  std::string still_a, still_b;
+  for (int i = 0; i < 2000; ++i) {
+    still_a += fmt::format("{:.3f} 0.001 0.0 0.0\n", i * 0.01);
+    still_b += fmt::format("{:.3f} 0.0 0.001 0.0\n", i * 0.01);
+  }
+  const fs::path a = write("a.txt", imu_table + still_a), b = write("b.txt", imu_table + still_b);
+  const std::string out2 = (dir_ / "out2.yaml").string(), rep2 = (dir_ / "rep2").string();
+  r = run("time-offset --reference " + a.string() + " --other " + b.string() +
+          " --sensor imu --rig " + kSample + " --out " + out2 + " --report " + rep2);
+  EXPECT_EQ(r.status, 3);
+  EXPECT_NE(r.err.find("not enough excitation"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out2));
+  EXPECT_EQ(nlohmann::json::parse(slurp(fs::path(rep2) / "report.json"))["verdict"],
+            "not enough excitation");
+
+  // Bad input: exit 2, one line, nothing written.
+  const std::string out3 = (dir_ / "out3.yaml").string(), rep3 = (dir_ / "rep3").string();
+  r = run("time-offset --reference " + a.string() + " --other " + b.string() +
+          " --sensor nope --rig " + kSample + " --out " + out3 + " --report " + rep3);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--sensor nope: no such sensor"), std::string::npos) << r.err;
+  r = run("time-offset --reference " + a.string() + " --other " + (dir_ / "missing.txt").string() +
+          " --report " + rep3);
+  EXPECT_EQ(r.status, 2);
+  r = run("time-offset --reference " + a.string() + " --other " + b.string() + " --out " + out3);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("give both"), std::string::npos) << r.err;
+  r = run("time-offset --reference " + a.string() + " --other " + b.string() +
+          " --max-offset soon");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_FALSE(fs::exists(out3));
+  EXPECT_FALSE(fs::exists(rep3));
+}
