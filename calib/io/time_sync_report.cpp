@@ -96,6 +96,7 @@ nlohmann::json time_sync_json(const TimeSyncResult& r, const time_sync::TimeSync
     }
     j["drift"] = {{"estimated", r.drift_estimated},
                   {"significant", r.drift_significant},
+                  {"significance_sigmas", number(r.drift_significance_sigma)},
                   {"drift_ppm", r.drift_estimated ? number(r.drift_ppm) : nlohmann::json()},
                   {"sigma_ppm", r.drift_estimated ? number(r.drift_sigma_ppm) : nlohmann::json()},
                   {"rule", "significant when |drift| > 3 sigma (at least 4 usable windows)"},

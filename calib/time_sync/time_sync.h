@@ -10,7 +10,7 @@
 // sensors. Both norms are resampled on common grids (the faster stream box-filtered to the slower
 // one's averaging interval when that is a pose-derived rate), a masked normalized
 // cross-correlation computed by FFT finds the peak over the search range at a coarse rate, a
-// direct correlation at the fine rate and a parabola refine it, and a 1-D golden-section search
+// direct correlation at the fine rate and a parabola refine it, and a 1-D minimization (Brent)
 // on the interpolated signals gives the continuous offset. Then, optionally, the relative
 // rotation and the gyro bias difference are estimated (Kabsch) and the offset is refined on all
 // three axes. Offsets in sliding windows give the drift by a linear fit.
@@ -49,7 +49,7 @@ struct TimeSyncOptions {
   double coarse_hz = 20.0;     // the FFT pass
   double fine_hz_max = 200.0;  // the fine grid: the faster stream's rate, at most this
   bool three_axis = true;      // estimate the relative rotation and refine on all three axes
-  // Drift: offsets in windows this long (0: the overlap / 8, at least 20 s), half-overlapping.
+  // Drift: offsets in consecutive windows this long (0: the overlap / 10, at least 20 s).
   double window_s = 0.0;
   // Not enough excitation: the standard deviation of |w| below this in either stream (rad/s).
   double min_excitation_rad_s = 0.05;
@@ -95,6 +95,8 @@ struct TimeSyncResult {
   double window_s = 0.0;
   bool drift_estimated = false, drift_significant = false;
   double drift_ppm = 0.0, drift_sigma_ppm = 0.0, window_residual_rms_s = 0.0;
+  // Significant: |drift| above this many drift sigmas (Student's t at 99.73 %, windows - 2 dof).
+  double drift_significance_sigma = 0.0;
   double mean_offset_s = 0.0;  // the offset without a drift model
   // For plots: the correlation around the peak (fine grid) and over the search range (coarse).
   std::vector<CorrelationPoint> fine_curve, coarse_curve;

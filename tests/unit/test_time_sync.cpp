@@ -24,8 +24,8 @@
 
 namespace rigcal::time_sync {
 
-// Shared with tests/long: one simulated trial, returns the error of the offset (s).
-double offset_trial_error_for_long_test(uint64_t seed, double true_offset_s);
+// Shared with tests/long: one simulated trial (2 minutes, 100 Hz both, no drift).
+TimeSyncResult offset_trial_for_long_test(uint64_t seed, double true_offset_s);
 
 namespace {
 
@@ -59,11 +59,11 @@ sim::ImuPart simulate(uint64_t seed, double offset, double duration = 120.0,
 
 }  // namespace
 
-double offset_trial_error_for_long_test(uint64_t seed, double true_offset_s) {
+TimeSyncResult offset_trial_for_long_test(uint64_t seed, double true_offset_s) {
   const sim::ImuPart part = simulate(seed, true_offset_s);
   const TimeSyncResult r = estimate_time_offset(rates_of(part.os_imu), rates_of(part.imu));
   EXPECT_EQ(r.verdict, "ok") << r.reason;
-  return r.offset_s - true_offset_s;
+  return r;
 }
 
 namespace {
@@ -73,18 +73,28 @@ namespace {
 TEST(TimeSyncSim, OffsetWithinHalfAMillisecond) {
   std::mt19937_64 rng(42);
   std::uniform_real_distribution<double> U(-0.2, 0.2);
-  double max_err = 0, sse = 0;
+  double max_err = 0, sse = 0, max_drift_z = 0;
+  int false_drift = 0, beyond_3_sigma = 0;
   const int trials = 10;
   for (int k = 0; k < trials; ++k) {
     const double truth = U(rng);
-    const double e = offset_trial_error_for_long_test(1000 + k, truth);
+    const TimeSyncResult r = offset_trial_for_long_test(1000 + k, truth);
+    const double e = r.offset_s - truth;
     max_err = std::max(max_err, std::abs(e));
     sse += e * e;
+    false_drift += r.drift_significant;
+    beyond_3_sigma += std::abs(e) > 3 * r.sigma_s;
+    max_drift_z = std::max(max_drift_z, std::abs(r.drift_ppm) / r.drift_sigma_ppm);
   }
   const double rms = std::sqrt(sse / trials);
-  std::printf("%d trials: max error %.4f ms, RMS %.4f ms\n", trials, 1e3 * max_err, 1e3 * rms);
+  std::printf(
+      "%d trials: max error %.4f ms, RMS %.4f ms; %d beyond 3 sigma; drift (truth 0) at most "
+      "%.2f sigma, flagged significant in %d\n",
+      trials, 1e3 * max_err, 1e3 * rms, beyond_3_sigma, max_drift_z, false_drift);
   EXPECT_LE(max_err, 0.5e-3);
   EXPECT_LE(rms, 0.2e-3);
+  EXPECT_EQ(false_drift, 0);
+  EXPECT_LE(beyond_3_sigma, 1);
 }
 
 // The reported sigma covers the error, and the three-axis stage finds the rotation between the
