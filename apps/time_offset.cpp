@@ -142,7 +142,7 @@ void run(Options o) {
         rpy.x(), rpy.y(), rpy.z(), r.residual_rms_rad_s);
   }
   if (r.drift_estimated) {
-    fmt::print("drift: {:.2f} ± {:.2f} ppm over {} windows of {:.0f} s: {}\n", r.drift_ppm,
+    fmt::print("drift: {:.3f} ± {:.3f} ppm over {} windows of {:.0f} s: {}\n", r.drift_ppm,
                r.drift_sigma_ppm, r.windows.size(), r.window_s,
                r.drift_significant ? "significant (offset given at the epoch, the other stream's "
                                      "first stamp)"

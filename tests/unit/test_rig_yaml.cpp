@@ -269,6 +269,15 @@ TEST(RigYaml, EveryValidationErrorNamesFileLineAndKey) {
                    "[[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}"),
        "rig.yaml:9: key 'thing': cannot tell what kind of sensor this is; add 'sensor_type: "
        "camera|lidar|imu|gnss'"},
+      {"drift without its epoch",
+       camera_with("lidar",
+                   "lidar: {T_b: [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]], time_drift_ppm: 20}"),
+       "rig.yaml:8: key 'lidar.time_drift_ppm': needs time_drift_epoch (s, this sensor's clock)"},
+      {"epoch without its drift",
+       camera_with("lidar",
+                   "lidar: {T_b: [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]], time_drift_epoch: "
+                   "12.5}"),
+       "rig.yaml:8: key 'lidar.time_drift_epoch': given without time_drift_ppm"},
       {"camera key on a lidar",
        camera_with(
            "lidar",
@@ -286,6 +295,24 @@ TEST(RigYaml, EveryValidationErrorNamesFileLineAndKey) {
       EXPECT_EQ(std::string(e.what()), c.expected) << c.yaml;
     }
   }
+}
+
+TEST(RigYaml, ClockDriftKeysRoundTripExactly) {
+  const std::string text = camera_with(
+      "lidar",
+      "lidar: {T_b: [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}\nimu:\n  sensor_type: imu\n"
+      "  T_b: [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]\n  time_offset: -0.0031\n"
+      "  time_drift_ppm: 19.993\n  time_drift_epoch: 1403715529.112143517");
+  const Rig rig = parse_rig_yaml(text, "rig.yaml");
+  const Sensor& imu = sensor(rig, "imu");
+  ASSERT_TRUE(imu.time_drift_ppm.has_value());
+  EXPECT_EQ(*imu.time_drift_ppm, 19.993);
+  EXPECT_EQ(imu.time_drift_epoch.ns, 1403715529112143517);  // every digit kept
+  EXPECT_FALSE(sensor(rig, "lidar").time_drift_ppm.has_value());
+  const Rig back = parse_rig_yaml(rig_to_yaml(rig), "back.yaml");
+  EXPECT_EQ(*sensor(back, "imu").time_drift_ppm, 19.993);
+  EXPECT_EQ(sensor(back, "imu").time_drift_epoch, imu.time_drift_epoch);
+  EXPECT_FALSE(sensor(back, "cam_l").time_drift_ppm.has_value());
 }
 
 TEST(RigYaml, RejectsEmptyAndNewerFiles) {
