@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # `make demo`: the main job on the bundled sample. Today: check the sample rig's calibration YAML,
-# show it, and write it in every export format. Each calibration step extends this script.
+# show it, and write it in every export format; then the calibration steps on a simulated session
+# (cameras, clock offset). Each calibration step extends this script.
 set -euo pipefail
 build=${1:-build}
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -50,3 +51,8 @@ echo "== camera calibration of the simulated stereo images (truth: the sample ri
 "$rigcal" cameras --session "$out/sim/stereo" --target "$root/targets/a3_checkerboard_8x5_40mm.yaml" \
   --rig "$sample" --out "$out/cameras/calib.yaml" --report "$out/cameras/report"
 echo "true values: cam_l fx 1085.3 fy 1084.7 cx 701.2 cy 349.6; baseline 0.4985 m (data/sample_rig.yaml)"
+
+echo
+echo "== clock offset between the simulated session's two IMUs (truth: imu time_offset -0.0031 s)"
+"$rigcal" time-offset --session "$out/sim" --rig "$out/cameras/calib.yaml" \
+  --out "$out/time_offset/calib.yaml" --report "$out/time_offset/report"
