@@ -194,7 +194,9 @@ void run(const Options& o) {
   rep.uncertainty_distance_m = distances[distances.size() / 2];
   const int nk = static_cast<int>(r.cameras[0].stddev.size());
   for (size_t c = 0; c < n_cams; ++c) {
-    rep.uncertainty.push_back(camera::projection_uncertainty(
+    rep.uncertainty.push_back(
+        camera::projection_uncertainty(r, static_cast<int>(c), rep.uncertainty_distance_m));
+    rep.uncertainty_intrinsics_only.push_back(camera::projection_uncertainty_intrinsics_only(
         r.cameras[c].model, r.covariance.block(c * nk, c * nk, nk, nk),
         rep.uncertainty_distance_m));
   }

@@ -335,16 +335,24 @@ CalibrationResult calibrate(const Target& target, const std::vector<CameraInput>
   const double dof = static_cast<double>(res.n_residuals) - static_cast<double>(res.n_parameters);
   res.noise_sigma_px = std::sqrt(sse / std::max(1.0, dof));
 
-  // Covariance of intrinsics and camera poses, scaled by the estimated noise.
+  // Covariance of intrinsics, camera poses and board poses, scaled by the estimated noise.
   std::vector<const double*> blocks;
   for (size_t c = 0; c < cams.size(); ++c) blocks.push_back(intr[c].data());
   for (size_t c = 1; c < cams.size(); ++c) {
     blocks.push_back(cam_pose[c].q.coeffs().data());
     blocks.push_back(cam_pose[c].t.data());
   }
+  int n_cov = static_cast<int>(cams.size()) * NK + 6 * (static_cast<int>(cams.size()) - 1);
+  res.board_covariance_index.assign(n_frames, -1);
+  for (size_t f = 0; f < n_frames; ++f) {
+    if (!board[f] || !problem.HasParameterBlock(board[f]->q.coeffs().data())) continue;
+    res.board_covariance_index[f] = n_cov;
+    n_cov += 6;
+    blocks.push_back(board[f]->q.coeffs().data());
+    blocks.push_back(board[f]->t.data());
+  }
   // Sparse QR first (fast on hundreds of board poses); dense SVD, which copes with a rank-deficient
   // problem, when it fails.
-  const int n_cov = static_cast<int>(cams.size()) * NK + 6 * (static_cast<int>(cams.size()) - 1);
   res.covariance = Eigen::MatrixXd::Zero(n_cov, n_cov);
   bool have_cov = false;
   for (const ceres::CovarianceAlgorithmType algorithm : {ceres::SPARSE_QR, ceres::DENSE_SVD}) {

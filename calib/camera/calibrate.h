@@ -55,7 +55,12 @@ struct CalibrationResult {
   double rms_coord_px = 0;    // mrcal's: sqrt(mean r_x^2, r_y^2) = rms_2d / sqrt(2)
   double noise_sigma_px = 0;  // per coordinate, from the residuals and the degrees of freedom
   size_t n_outliers = 0, n_parameters = 0, n_residuals = 0;
-  Eigen::MatrixXd covariance;  // of all intrinsics and extrinsics (tangent space), scaled
+  // Of every parameter, tangent space, scaled by noise_sigma_px^2: the intrinsics of each camera
+  // (camera c at c * NK), then T_cami_cam0 for i >= 1 (3 rotation + 3 translation each), then
+  // the board pose T_cam0_board of frame f at board_covariance_index[f] (-1: no pose). Rotation
+  // tangents are Ceres' quaternion ones: d rotates by 2|d| about d, on the left.
+  Eigen::MatrixXd covariance;
+  std::vector<int> board_covariance_index;
   std::vector<std::string> notes;
 };
 

@@ -107,6 +107,12 @@ Detection detect_aprilgrid(const cv::Mat& gray, const Target& t, const DetectOpt
   cv::Ptr<cv::aruco::DetectorParameters> params = cv::aruco::DetectorParameters::create();
   params->markerBorderBits = 2;
   params->minMarkerDistanceRate = 0.01;  // Kalibr's neighbours are 0.3 tag sizes apart
+  // Small tags fail in decoding (quads found, bits unread at ~3.5 px a bit): sampling each bit on
+  // 8 x 8 pixels of the rectified tag, ignoring 0.25 of a bit at its edges, reads more of them.
+  // On 40 simulated views of the 6 x 6 grid: 849 of 1440 tags against 800 with aruco's defaults
+  // (adaptive-threshold windows 3..53 px add 18 more, at four times the detection time).
+  params->perspectiveRemovePixelPerCell = 8;
+  params->perspectiveRemoveIgnoredMarginPerCell = 0.25;
   std::vector<int> ids;
   std::vector<std::vector<cv::Point2f>> tags;
   cv::aruco::detectMarkers(gray, dict, tags, ids, params);

@@ -105,8 +105,11 @@ nlohmann::json cameras_json(const camera::CalibrationResult& r, const CameraRepo
        "covariance"},
       {"stddev", "1-sigma of each parameter from the covariance"},
       {"projection_uncertainty",
-       "worst-direction 1-sigma of a pixel's projection at uncertainty_distance_m, from the "
-       "intrinsics' covariance only"}};
+       "worst-direction 1-sigma of a pixel's projection at uncertainty_distance_m, as mrcal "
+       "defines it: the point fixed in the boards' frames, every parameter (intrinsics, camera "
+       "and board poses) perturbed by the covariance, the camera re-finding it as the mean over "
+       "the frames; intrinsics_only_*: a point fixed in the camera frame through perturbed "
+       "intrinsics (no board poses), for comparison"}};
   for (size_t c = 0; c < r.cameras.size(); ++c) {
     const camera::CameraResult& cr = r.cameras[c];
     nlohmann::json cj;
@@ -133,6 +136,12 @@ nlohmann::json cameras_json(const camera::CalibrationResult& r, const CameraRepo
                                       {"mean_px", u.mean_px},
                                       {"max_px", u.max_px},
                                       {"centre_px", u.centre_px}};
+      if (c < in.uncertainty_intrinsics_only.size()) {
+        const camera::UncertaintyMap& ui = in.uncertainty_intrinsics_only[c];
+        cj["projection_uncertainty"]["intrinsics_only_mean_px"] = ui.mean_px;
+        cj["projection_uncertainty"]["intrinsics_only_max_px"] = ui.max_px;
+        cj["projection_uncertainty"]["intrinsics_only_centre_px"] = ui.centre_px;
+      }
     }
     if (c > 0) {
       const SE3 T_c0 = r.T_cam_cam0[c];

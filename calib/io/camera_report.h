@@ -23,8 +23,9 @@ std::map<std::string, camera::Detection> parse_corners_vnl(std::string_view text
 
 struct CameraReportInput {
   std::vector<std::string> camera_names;
-  std::vector<std::vector<std::string>> images;  // per camera, per frame ("" where none)
-  std::vector<camera::UncertaintyMap> uncertainty;
+  std::vector<std::vector<std::string>> images;     // per camera, per frame ("" where none)
+  std::vector<camera::UncertaintyMap> uncertainty;  // mrcal's definition, per camera
+  std::vector<camera::UncertaintyMap> uncertainty_intrinsics_only;  // for comparison
   double uncertainty_distance_m = 0;
   std::map<std::string, std::string> inputs;
 };
