@@ -9,8 +9,11 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "camera_truth.h"
 #include "fixtures.h"
 #include "rigcal/camera/calibrate.h"
+#include "rigcal/camera/lens.h"
+#include "rigcal/camera/uncertainty.h"
 #include "rigcal/core/error.h"
 #include "rigcal/io/camera_report.h"
 #include "rigcal/io/target_pdf.h"
@@ -89,12 +92,50 @@ TEST(CameraReal, OpenCvStereoSamplesMeetTheBarAndMatchOpenCvOnTheSameCorners) {
 struct SimCase {
   rig::DistortionModel model;
   std::vector<double> left_coeffs, right_coeffs;
+  std::string target_file;  // empty: the simulator's default, the A3 checkerboard
 };
+
+// The projection error, as mrcal defines it, of the pixel q at distance d: the true point
+// p_c = d * ray(q) (true lens) fixed in the true board frames, found again by the estimate as
+// the mean over the frames of T^_cam0_board_f p_board_f, then T^_c_0 and the estimated lens.
+// Compared with the mrcal-style map's 1-sigma of that cell: |e| / sigma_worst.
+std::vector<double> projection_z(const CalibrationResult& r, const sim::StereoPart& part,
+                                 const rig::Rig& rig, int camera, double distance, bool print) {
+  const rig::CameraModel& truth = rig::sensor(rig, camera ? "cam_r" : "cam_l").camera;
+  const SE3 T_c0_true = rig::T_a_b(rig, camera ? "cam_r" : "cam_l", "cam_l");
+  const UncertaintyMap map = projection_uncertainty(r, camera, distance);
+  std::vector<double> z;
+  for (const auto& [fr, fc] : std::vector<std::pair<double, double>>{
+           {0.5, 0.5}, {0.25, 0.25}, {0.25, 0.75}, {0.75, 0.25}, {0.75, 0.75}}) {
+    const int row = static_cast<int>(fr * map.rows), col = static_cast<int>(fc * map.cols);
+    const Eigen::Vector2d q((col + 0.5) * map.cell_px, (row + 0.5) * map.cell_px);
+    const Eigen::Vector2d xn = unproject(truth, q);
+    const Eigen::Vector3d p_0 =
+        T_c0_true.inverse() * (distance * Eigen::Vector3d(xn.x(), xn.y(), 1.0).normalized());
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    int n = 0;
+    for (size_t f = 0; f < r.board_covariance_index.size(); ++f) {
+      if (r.board_covariance_index[f] < 0) continue;
+      mean += *r.T_cam0_board[f] * (part.T_left_board[f].inverse() * p_0);
+      ++n;
+    }
+    const Eigen::Vector2d q_est =
+        *project(r.cameras[camera].model, r.T_cam_cam0[camera] * (mean / n));
+    const double sigma = map.sigma_px[row * map.cols + col];
+    z.push_back((q_est - q).norm() / sigma);
+    if (print) {
+      std::printf(
+          "  camera %d pixel (%.0f, %.0f): projection error %.4f px (%+.4f, %+.4f), mrcal-style "
+          "1-sigma %.4f px\n",
+          camera, q.x(), q.y(), (q_est - q).norm(), (q_est - q).x(), (q_est - q).y(), sigma);
+    }
+  }
+  return z;
+}
 
 // Simulated truth: the default 40 views of the A3 board at the default noise, 1388 x 700.
 // Returns, per checked quantity, the error in units of the reported 1-sigma.
-std::vector<double> check_against_truth(const SimCase& sc, uint64_t seed, bool print,
-                                        bool strict = true) {
+TruthZ check_against_truth(const SimCase& sc, uint64_t seed, bool print, bool strict = true) {
   rig::Rig rig = rig::read_rig_file(RIGCAL_SOURCE_DIR "/data/sample_rig.yaml");
   rig::sensor(rig, "cam_l").camera.distortion_model = sc.model;
   rig::sensor(rig, "cam_r").camera.distortion_model = sc.model;
@@ -102,6 +143,7 @@ std::vector<double> check_against_truth(const SimCase& sc, uint64_t seed, bool p
   rig::sensor(rig, "cam_r").camera.distortion_coeffs = sc.right_coeffs;
   sim::SimConfig cfg;
   cfg.seed = seed;
+  if (!sc.target_file.empty()) cfg.target = io::read_target_file(sc.target_file);
   const sim::StereoPart part = sim::simulate_stereo(rig, cfg);
   std::vector<CameraInput> cams(2);
   cams[0].name = "cam_l";
@@ -115,11 +157,14 @@ std::vector<double> check_against_truth(const SimCase& sc, uint64_t seed, bool p
   opt.model = sc.model;
   const CalibrationResult r = calibrate(cfg.target, cams, opt);
   const SE3 T_true = rig::T_a_b(rig, "cam_r", "cam_l");
+  TruthZ out;
   for (int c = 0; c < 2; ++c) {
     const rig::CameraModel& truth = rig::sensor(rig, c ? "cam_r" : "cam_l").camera;
     const rig::CameraModel& est = r.cameras[c].model;
     const double f_rel = std::max(std::abs(est.fx / truth.fx - 1), std::abs(est.fy / truth.fy - 1));
     const double pp = std::max(std::abs(est.cx - truth.cx), std::abs(est.cy - truth.cy));
+    out.focal_rel = std::max(out.focal_rel, f_rel);
+    out.principal_point_px = std::max(out.principal_point_px, pp);
     if (print) {
       std::printf(
           "seed %lu camera %d: focal rel. error %.2e, principal point %.3f px (1-sigma reported "
@@ -166,7 +211,29 @@ std::vector<double> check_against_truth(const SimCase& sc, uint64_t seed, bool p
       z.push_back(std::abs(k_est[i] - k_true[i]) / r.cameras[c].stddev[i]);
   }
   for (int i = 0; i < 3; ++i) z.push_back(std::abs(rot_err[i]) / r.rotation_stddev_deg[1][i]);
-  return z;
+  // Projection uncertainty as mrcal defines it, at the median board distance.
+  std::vector<double> distances;
+  for (const auto& T : r.T_cam0_board) {
+    if (T) distances.push_back(T->t.norm());
+  }
+  std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
+  const double d = distances[distances.size() / 2];
+  std::vector<double> zp;
+  for (int c = 0; c < 2; ++c) {
+    for (double x : projection_z(r, part, rig, c, d, print)) zp.push_back(x);
+  }
+  if (strict) {
+    // One seed is one draw of a mostly common error (the ten pixels move together): a gross
+    // check here (a wrong Jacobian or a factor of 2 shows as 5 sigma and more); the statistical
+    // check over 20 seeds is tests/long (CameraSimLong). Seed 1 gives at most 1.5 sigma on the
+    // A3 board with radtan, 3.4 with equidistant, 3.7 with the AprilGrid (doc/cameras.md).
+    for (double x : zp) EXPECT_LE(x, 5.0);
+  }
+  out.parameters = z;
+  out.projection = zp;
+  out.baseline_m = baseline_err;
+  out.rotation_deg = rot_err.norm();
+  return out;
 }
 
 const SimCase kRadtan{rig::DistortionModel::radtan,
@@ -179,9 +246,7 @@ const SimCase kEquidistant{rig::DistortionModel::equidistant,
 }  // namespace
 
 // For tests/long: the same check for any seed.
-std::vector<double> check_against_truth_for_long_test(rig::DistortionModel model, uint64_t seed) {
-  // Every seed's figures are printed; no bar is asserted per seed: the long test asserts the
-  // 3-sigma coverage over all seeds.
+TruthZ check_against_truth_for_long_test(rig::DistortionModel model, uint64_t seed) {
   return check_against_truth(model == rig::DistortionModel::radtan ? kRadtan : kEquidistant, seed,
                              /*print=*/true, /*strict=*/false);
 }
@@ -191,6 +256,22 @@ namespace {
 TEST(CameraSim, RadtanMeetsTheTruthBar) { check_against_truth(kRadtan, 1, true); }
 
 TEST(CameraSim, EquidistantMeetsTheTruthBar) { check_against_truth(kEquidistant, 1, true); }
+
+// The same 40 views with the 6 x 6 AprilGrid (88 mm tags, 144 corners a view where the A3 board
+// has 40): more information a view, so the issue's bars themselves are asserted.
+TEST(CameraSim, AprilGridMeetsTheIssuesBars) {
+  SimCase sc = kRadtan;
+  sc.target_file = RIGCAL_SOURCE_DIR "/targets/aprilgrid_6x6_88mm.yaml";
+  const TruthZ t = check_against_truth(sc, 1, true);
+  std::printf(
+      "AprilGrid, radtan, seed 1: focal %.2e, principal point %.3f px, baseline %.3f mm, "
+      "rotation %.4f deg\n",
+      t.focal_rel, t.principal_point_px, 1e3 * t.baseline_m, t.rotation_deg);
+  EXPECT_LE(t.focal_rel, 2e-4);
+  EXPECT_LE(t.principal_point_px, 0.3);
+  EXPECT_LE(t.baseline_m, 0.2e-3);
+  EXPECT_LE(t.rotation_deg, 0.01);
+}
 
 TEST(CameraInputErrors, ClearMessages) {
   const Target target = sim::default_target();
