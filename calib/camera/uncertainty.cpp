@@ -4,6 +4,7 @@
 
 #include "rigcal/camera/calibrate.h"
 #include "rigcal/camera/lens.h"
+#include "rigcal/core/se3.h"
 
 namespace rigcal::camera {
 namespace {
@@ -13,12 +14,6 @@ rig::CameraModel with(const rig::CameraModel& m, const std::vector<double>& k) {
   out.fx = k[0], out.fy = k[1], out.cx = k[2], out.cy = k[3];
   out.distortion_coeffs.assign(k.begin() + 4, k.end());
   return out;
-}
-
-Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d S;
-  S << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-  return S;
 }
 
 // d project(model with k, p) / d k, by central differences.

@@ -238,10 +238,12 @@ TruthZ check_against_truth(const SimCase& sc, uint64_t seed, bool print, bool st
 
 const SimCase kRadtan{rig::DistortionModel::radtan,
                       {-0.0921, 0.0874, 0.00031, -0.00027},
-                      {-0.0897, 0.0832, -0.00019, 0.00042}};
+                      {-0.0897, 0.0832, -0.00019, 0.00042},
+                      ""};
 const SimCase kEquidistant{rig::DistortionModel::equidistant,
                            {0.02, -0.015, 0.004, -0.001},
-                           {0.018, -0.012, 0.003, -0.0008}};
+                           {0.018, -0.012, 0.003, -0.0008},
+                           ""};
 
 }  // namespace
 

@@ -1,0 +1,71 @@
+#pragma once
+// Hand-eye calibration from two trajectories of one rigid body: the LiDAR's odometry and the
+// GNSS/INS's poses (issue 7; doc/hand-eye.md). The unknown is X = T_gnss_lidar, the LiDAR in the
+// GNSS/INS frame. For the motion between two instants, A = T_L(t0)^-1 T_L(t1) (the LiDAR's) and
+// B = T_G(t0)^-1 T_G(t1) (the GNSS/INS's) satisfy
+//     B X = X A:   R_B R_X = R_X R_A,   (R_B - I) t_X = R_X t_A - t_B.
+// The rotation axes therefore satisfy axis(B) = R_X axis(A): the rotation follows from the axes
+// (Kabsch, the least-squares form of Park and Martin's), then the translation by least squares.
+// Both are conditioned by how the rotation axes spread: motion about one axis only (a car on a
+// plane turns about the vertical) leaves the rotation about that axis poorly determined and the
+// translation along it not at all; Observability says so in numbers.
+#include <Eigen/Core>
+#include <vector>
+
+#include "rigcal/core/se3.h"
+#include "rigcal/core/time.h"
+#include "rigcal/core/trajectory.h"
+
+namespace rigcal::hand_eye {
+
+struct MotionPair {
+  Time t0, t1;  // on the LiDAR's clock
+  SE3 A;        // T_L0_L1, the LiDAR's motion (odometry interpolated at t0, t1)
+  SE3 B;        // T_G0_G1, the GNSS/INS's motion
+};
+
+struct PairOptions {
+  double spacing_s = 1.0;         // t1 - t0, consecutive pairs (non-overlapping)
+  double min_rotation_deg = 1.0;  // pairs whose GNSS/INS rotation is smaller are dropped
+  // The GNSS/INS clock: t_lidar = t_gnss + time_offset_s (its time_offset in the rig when the
+  // LiDAR is on the base clock).
+  double time_offset_s = 0.0;
+  double max_gap_s = 0.5;  // longest LiDAR pose interval interpolated across
+};
+
+// Pairs along the GNSS/INS trajectory: a GNSS/INS pose at t0, the first one at least spacing_s
+// later at t1, the LiDAR odometry interpolated (slerp + linear) at both instants. Pairs outside
+// the odometry, across a gap, or rotating too little are skipped.
+std::vector<MotionPair> motion_pairs(const Trajectory& T_odom_lidar, const Trajectory& T_enu_gnss,
+                                     const PairOptions& options = {});
+
+struct Observability {
+  // Singular values (descending) of the stacked rotation vectors of the LiDAR motions, rad: all
+  // three large when the motion turns about spread axes; a small third one means one direction
+  // of rotation axes is missing.
+  Eigen::Vector3d rotation_singular_values = Eigen::Vector3d::Zero();
+  // Singular values (descending) of the stacked (R_B - I), and their right singular vectors
+  // (columns, GNSS/INS frame): the translation along a column whose value is small is not
+  // determined by the data.
+  Eigen::Vector3d translation_singular_values = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d translation_directions = Eigen::Matrix3d::Identity();
+  // 1-sigma of the translation along each of those directions, m: the RMS of the stacked
+  // residuals (per coordinate, with the degrees of freedom) over the singular value.
+  Eigen::Vector3d translation_sigma_m = Eigen::Vector3d::Zero();
+  // Directions (columns of translation_directions) the data do not determine: a 1-sigma above
+  // max_sigma_m, or a singular value below 1e-3 of the largest. Their translation component is
+  // set to 0 (minimum norm), not estimated.
+  std::vector<int> unobservable;
+};
+
+struct ClosedForm {
+  SE3 T_gnss_lidar;
+  Observability observability;
+  size_t pairs = 0;
+  double rotation_residual_rms_deg = 0.0;  // of the axes after the fit
+};
+
+// Throws rigcal::Error with fewer than 3 pairs.
+ClosedForm closed_form(const std::vector<MotionPair>& pairs, double max_sigma_m = 0.1);
+
+}  // namespace rigcal::hand_eye
