@@ -1,5 +1,7 @@
 #include "rigcal/hand_eye/hand_eye.h"
 
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
 #include <fmt/format.h>
 
 #include <Eigen/SVD>
@@ -26,7 +28,112 @@ std::optional<SE3> pose_at(const Trajectory& traj, Time t, Time max_gap) {
                             (t - a).seconds() / (b - a).seconds());
 }
 
+// One pair: rotation 2 vec(q_B^-1 q_X q_A q_X^-1) and translation R_B t_X + t_B - R_X t_A - t_X,
+// each over its sigma.
+struct PairError {
+  Eigen::Quaterniond q_A, q_B;
+  Eigen::Vector3d t_A, t_B;
+  double rot_sigma, trans_sigma;
+  template <typename T>
+  bool operator()(const T* q_x, const T* t_x, T* r) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> qX(q_x);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> tX(t_x);
+    const Eigen::Quaternion<T> qA = q_A.cast<T>(), qB = q_B.cast<T>();
+    const Eigen::Quaternion<T> e = qB.conjugate() * qX * qA * qX.conjugate();
+    const T sign = e.w() < T(0) ? T(-1) : T(1);
+    for (int i = 0; i < 3; ++i) r[i] = sign * T(2) * e.vec()[i] / T(rot_sigma);
+    const Eigen::Matrix<T, 3, 1> et = qB * tX + t_B.cast<T>() - qX * t_A.cast<T>() - tX;
+    for (int i = 0; i < 3; ++i) r[3 + i] = et[i] / T(trans_sigma);
+    return true;
+  }
+};
+
+struct FixedError {
+  Eigen::Vector3d direction;
+  double value;
+  template <typename T>
+  bool operator()(const T* t_x, T* r) const {
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> tX(t_x);
+    r[0] = (direction.cast<T>().dot(tX) - T(value)) / T(1e-6);
+    return true;
+  }
+};
+
 }  // namespace
+
+Refined refine(const std::vector<MotionPair>& pairs, const SE3& initial, const RefineOptions& o) {
+  if (pairs.size() < 3)
+    throw Error(fmt::format("{} motion pairs; at least 3 are needed", pairs.size()));
+  Eigen::Quaterniond q = initial.quaternion();
+  Eigen::Vector3d t = initial.t;
+  const double rot_sigma = o.rotation_sigma_deg * M_PI / 180.0;
+  ceres::Problem problem;
+  for (const MotionPair& p : pairs) {
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<PairError, 6, 4, 3>(new PairError{
+            p.A.quaternion(), p.B.quaternion(), p.A.t, p.B.t, rot_sigma, o.translation_sigma_m}),
+        new ceres::HuberLoss(o.huber), q.coeffs().data(), t.data());
+  }
+  for (const RefineOptions::Fixed& f : o.fixed) {
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<FixedError, 1, 3>(
+                                 new FixedError{f.direction.normalized(), f.value_m}),
+                             nullptr, t.data());
+  }
+  problem.SetManifold(q.coeffs().data(), new ceres::EigenQuaternionManifold);
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.max_num_iterations = 100;
+  so.num_threads = 1;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &problem, &summary);
+
+  Refined out;
+  out.T_gnss_lidar = SE3::from_quaternion(q, t);
+  const SE3& X = out.T_gnss_lidar;
+  // Outliers: a pair's squared normalized residual (6 components) beyond the 99.9 % point of
+  // chi-square with 6 dof (22.46), after scaling the sigmas by the residuals' own level (the
+  // median of chi-square(6) is 5.35), so that sigmas set too small do not flag every pair.
+  std::vector<double> z2s;
+  for (const MotionPair& p : pairs) {
+    const SE3 E = (X * p.A).inverse() * (p.B * X);
+    const double rr = rotation_angle(E.R), tr = (p.B.R * X.t + p.B.t - X.R * p.A.t - X.t).norm();
+    out.pair_rotation_residual_deg.push_back(rr * 180.0 / M_PI);
+    out.pair_translation_residual_m.push_back(tr);
+    z2s.push_back(std::pow(rr / rot_sigma, 2) + std::pow(tr / o.translation_sigma_m, 2));
+  }
+  std::vector<double> sorted = z2s;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double level2 = std::max(1e-12, sorted[sorted.size() / 2] / 5.35);
+  double ss = 0;
+  size_t n_in = 0;
+  for (double z2 : z2s) {
+    const bool outlier = z2 / level2 > 22.46;
+    out.outlier.push_back(outlier);
+    if (!outlier) ss += z2, ++n_in;
+  }
+  const double dof =
+      std::max(1.0, 6.0 * static_cast<double>(n_in) - 6.0 + static_cast<double>(o.fixed.size()));
+  out.noise_scale = std::sqrt(ss / dof);
+  ceres::Covariance::Options co;
+  co.algorithm_type = ceres::DENSE_SVD;
+  co.null_space_rank = -1;
+  ceres::Covariance cov(co);
+  std::vector<std::pair<const double*, const double*>> blocks = {
+      {q.coeffs().data(), q.coeffs().data()}, {q.coeffs().data(), t.data()}, {t.data(), t.data()}};
+  if (cov.Compute(blocks, &problem)) {
+    Eigen::Matrix<double, 3, 3, Eigen::RowMajor> qq, qt, tt;
+    cov.GetCovarianceBlockInTangentSpace(q.coeffs().data(), q.coeffs().data(), qq.data());
+    cov.GetCovarianceBlockInTangentSpace(q.coeffs().data(), t.data(), qt.data());
+    cov.GetCovarianceBlock(t.data(), t.data(), tt.data());
+    // Ceres' quaternion tangent d rotates by 2|d|: rotation covariance is 4 times.
+    out.covariance.block<3, 3>(0, 0) = 4.0 * qq;
+    out.covariance.block<3, 3>(0, 3) = 2.0 * qt;
+    out.covariance.block<3, 3>(3, 0) = 2.0 * qt.transpose();
+    out.covariance.block<3, 3>(3, 3) = tt;
+    out.covariance *= out.noise_scale * out.noise_scale;
+  }
+  return out;
+}
 
 std::vector<MotionPair> motion_pairs(const Trajectory& lidar, const Trajectory& gnss,
                                      const PairOptions& o) {

@@ -68,4 +68,34 @@ struct ClosedForm {
 // Throws rigcal::Error with fewer than 3 pairs.
 ClosedForm closed_form(const std::vector<MotionPair>& pairs, double max_sigma_m = 0.1);
 
+struct RefineOptions {
+  // Per-pair noise: a pair's residual is scaled by these (rotation error of R_B R_X vs R_X R_A;
+  // translation error of B X vs X A, GNSS/INS frame).
+  double rotation_sigma_deg = 0.05;
+  double translation_sigma_m = 0.02;
+  double huber = 3.0;  // robust loss width, in those sigmas
+  // Translation components held at a value, not estimated: t . direction = value (a unit
+  // direction in the GNSS/INS frame; e.g. the vertical on a car, with the value measured by tape).
+  struct Fixed {
+    Eigen::Vector3d direction;
+    double value_m = 0.0;
+  };
+  std::vector<Fixed> fixed;
+};
+
+struct Refined {
+  SE3 T_gnss_lidar;
+  // 6 x 6 covariance: rotation (left tangent, rad: R = exp(d) R_X) then translation (m), scaled
+  // by the noise estimated from the residuals; fixed directions have (near) zero variance.
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  std::vector<double> pair_rotation_residual_deg, pair_translation_residual_m;
+  std::vector<bool> outlier;  // beyond the 99.9 % of chi-square(6) at the residuals' level
+  double noise_scale = 1.0;   // RMS of the normalized residuals: the sigmas' correction factor
+};
+
+// Nonlinear least squares over X from `initial` (Ceres, Huber loss): all pairs' rotation and
+// translation residuals together, unlike the closed form's two separate steps.
+Refined refine(const std::vector<MotionPair>& pairs, const SE3& initial,
+               const RefineOptions& options = {});
+
 }  // namespace rigcal::hand_eye

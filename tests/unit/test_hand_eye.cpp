@@ -105,6 +105,46 @@ TEST(HandEyeSim, CarLeavesTheVerticalUnobservable) {
   EXPECT_NEAR(s.result.T_gnss_lidar.t.dot(dir), 0.0, 1e-12);  // not estimated: no number given
 }
 
+// Acceptance 1 (closed form + refinement, no time offset estimated yet), hand-held: rotation
+// <= 0.05 deg, translation <= 1 cm; and the reported sigmas cover the errors.
+TEST(HandEyeSim, HandHeldRefined) {
+  const SimRun s = simulate_and_solve(sim::MotionKind::handheld, 1);
+  const Refined r = refine(s.pairs, s.result.T_gnss_lidar);
+  const double rot = rotation_error_deg(r.T_gnss_lidar, s.truth);
+  const Eigen::Vector3d e = r.T_gnss_lidar.t - s.truth.t;
+  size_t outliers = 0;
+  for (bool o : r.outlier) outliers += o;
+  std::printf(
+      "hand-held, refined: rotation error %.4f deg (1-sigma %.4f %.4f %.4f), translation error "
+      "%.2f mm (1-sigma %.2f %.2f %.2f); %zu of %zu pairs beyond the loss; noise scale %.2f\n",
+      rot, std::sqrt(r.covariance(0, 0)) * 180 / M_PI, std::sqrt(r.covariance(1, 1)) * 180 / M_PI,
+      std::sqrt(r.covariance(2, 2)) * 180 / M_PI, 1e3 * e.norm(),
+      1e3 * std::sqrt(r.covariance(3, 3)), 1e3 * std::sqrt(r.covariance(4, 4)),
+      1e3 * std::sqrt(r.covariance(5, 5)), outliers, r.outlier.size(), r.noise_scale);
+  EXPECT_LE(rot, 0.05);
+  EXPECT_LE(e.norm(), 0.01);
+  for (int i = 0; i < 3; ++i) EXPECT_LE(std::abs(e[i]), 3 * std::sqrt(r.covariance(3 + i, 3 + i)));
+}
+
+// Acceptance 1, car: with the unobservable direction fixed at its true value (what `--fix z=...`
+// gives), rotation <= 0.1 deg and the other two translation components <= 2 cm.
+TEST(HandEyeSim, CarRefinedWithTheVerticalFixed) {
+  const SimRun s = simulate_and_solve(sim::MotionKind::car, 1);
+  ASSERT_EQ(s.result.observability.unobservable.size(), 1u);
+  const Eigen::Vector3d d =
+      s.result.observability.translation_directions.col(s.result.observability.unobservable[0]);
+  RefineOptions o;
+  o.fixed.push_back({d, d.dot(s.truth.t)});
+  const Refined r = refine(s.pairs, s.result.T_gnss_lidar, o);
+  const double rot = rotation_error_deg(r.T_gnss_lidar, s.truth);
+  const Eigen::Vector3d e = r.T_gnss_lidar.t - s.truth.t;
+  const Eigen::Vector3d in_plane = e - d * d.dot(e);
+  std::printf("car, refined with the vertical fixed: rotation error %.4f deg, in-plane %.2f mm\n",
+              rot, 1e3 * in_plane.norm());
+  EXPECT_LE(rot, 0.1);
+  EXPECT_LE(in_plane.norm(), 0.02);
+}
+
 // OpenCV's calibrateHandEye on the same motions: the pairs chained into stations (GNSS/INS =
 // gripper, LiDAR = camera, the odometry frame = the target), every method. Its X is cam2gripper,
 // T_gnss_lidar. OpenCV forms a motion from every two stations (i < j), not only consecutive
