@@ -23,6 +23,8 @@ void add_simulate(CLI::App& app);
 void add_cameras(CLI::App& app);
 // `rigcal time-offset`
 void add_time_offset(CLI::App& app);
+// `rigcal hand-eye`
+void add_hand_eye(CLI::App& app);
 // `rigcal target print`
 void add_target_print(CLI::App& target);
 

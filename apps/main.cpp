@@ -19,7 +19,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.footer(
       "Exit status: 0 success, 2 bad input (the message names file, line and key), 1 bug;\n"
-      "time-offset: 3 when the data give no offset.");
+      "time-offset: 3 when the data give no offset; hand-eye: 3 when a direction is undetermined.");
 
   CLI::App* rig = app.add_subcommand("rig", "Check, show and convert a calibration YAML");
   rig->require_subcommand(1);
@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
   rigcal::cli::add_simulate(app);
   rigcal::cli::add_cameras(app);
   rigcal::cli::add_time_offset(app);
+  rigcal::cli::add_hand_eye(app);
   CLI::App* target = app.add_subcommand("target", "Calibration targets: printable PDFs");
   target->require_subcommand(1);
   rigcal::cli::add_target_print(*target);

@@ -226,7 +226,8 @@ void add_time_offset(CLI::App& app) {
   cmd->add_option("--min-overlap", o->min_overlap,
                   "overlap a lag must leave, fraction of the shorter stream")
       ->capture_default_str();
-  cmd->add_option("--window", o->window_s, "drift windows in seconds (0: overlap/10, at least 20 s)")
+  cmd->add_option("--window", o->window_s,
+                  "drift windows in seconds (0: overlap/10, at least 20 s)")
       ->capture_default_str();
   cmd->add_option("--min-excitation", o->min_excitation,
                   "rad/s: std of |w| below this is 'not enough excitation'")

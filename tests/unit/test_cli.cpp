@@ -430,3 +430,49 @@ TEST_F(Cli, TimeOffsetWritesTheSensorsOffsetAndDrift) {
   EXPECT_FALSE(fs::exists(out3));
   EXPECT_FALSE(fs::exists(rep3));
 }
+
+TEST_F(Cli, HandEyeWritesTheExtrinsicAndRefusesAnUndeterminedDirection) {
+  const fs::path hand = dir_ / "hand", car = dir_ / "car";
+  ASSERT_EQ(run("simulate --what trajectories --out " + hand.string()).status, 0);
+  const fs::path cfg = write("car.yaml", "trajectories:\n  motion: car\n");
+  ASSERT_EQ(run("simulate --what trajectories --out " + car.string() + " --config " + cfg.string())
+                .status,
+            0);
+  auto args = [](const fs::path& s) {
+    return " --lidar " + (s / "trajectories" / "lidar_odometry.tum").string() + " --gnss " +
+           (s / "trajectories" / "gnss_ins.tum").string();
+  };
+  const std::string out = (dir_ / "out.yaml").string(), rep = (dir_ / "rep").string();
+  CliRun r =
+      run("hand-eye" + args(hand) + " --rig " + kSample + " --out " + out + " --report " + rep);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(run("rig validate " + out).status, 0);
+  // T_gnss_lidar against the sample rig's (the simulator's truth): within 1 cm.
+  const nlohmann::json j = nlohmann::json::parse(slurp(fs::path(rep) / "hand_eye.json"));
+  EXPECT_TRUE(j["observability"]["unobservable_directions"].empty());
+  const std::vector<double> t = j["T_gnss_lidar"]["t_m"];
+  const double truth[3] = {0.0500, 0.0028, -0.1399};  // -R^T t of the sample rig's gnss T_b
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(t[i], truth[i], 0.01) << i;
+  for (const char* f : {"hand_eye.json", "residuals.png", "trajectories.png"})
+    EXPECT_TRUE(fs::exists(fs::path(rep) / f)) << f;
+  // A car without a rig or --fix: the vertical is undetermined; exit 3, nothing written.
+  const std::string rep2 = (dir_ / "rep2").string();
+  r = run("hand-eye" + args(car) + " --report " + rep2);
+  EXPECT_EQ(r.status, 3);
+  EXPECT_NE(r.err.find("does not determine the translation"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(rep2));
+  // With --fix it answers, and holds the value.
+  r = run("hand-eye" + args(car) + " --fix z=-0.1399 --report " + rep2);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j2 = nlohmann::json::parse(slurp(fs::path(rep2) / "hand_eye.json"));
+  EXPECT_NEAR(j2["T_gnss_lidar"]["t_m"][2].get<double>(), -0.1399, 1e-4);
+  // Trajectories that do not overlap in time, and too few pairs: exit 2.
+  const fs::path a = write("a.tum", "0 0 0 0 0 0 0 1\n1 1 0 0 0 0 0 1\n2 2 0 0 0 0 0 1\n");
+  const fs::path b = write("b.tum", "100 0 0 0 0 0 0 1\n101 1 0 0 0 0 0 1\n102 2 0 0 0 0 0 1\n");
+  r = run("hand-eye --lidar " + a.string() + " --gnss " + b.string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("do not overlap in time"), std::string::npos) << r.err;
+  r = run("hand-eye --lidar " + a.string() + " --gnss " + a.string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("too few or too small motions"), std::string::npos) << r.err;
+}

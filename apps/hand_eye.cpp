@@ -1,0 +1,284 @@
+// rigcal hand-eye: the GNSS/INS-to-LiDAR extrinsic from the two trajectories (doc/hand-eye.md).
+#include "rigcal/hand_eye/hand_eye.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "cli.h"
+#include "rigcal/core/error.h"
+#include "rigcal/core/se3.h"
+#include "rigcal/core/version.h"
+#include "rigcal/io/files.h"
+#include "rigcal/io/svg_plot.h"
+#include "rigcal/io/trajectory_io.h"
+#include "rigcal/rig/rig_yaml.h"
+
+namespace rigcal::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Options {
+  std::string lidar, gnss, sensor = "gnss", lidar_sensor = "lidar", rig, out, report;
+  std::vector<std::string> fix;  // AXIS=VALUE, GNSS/INS frame
+  double spacing_s = 1.0, min_rotation_deg = 1.0, rotation_sigma_deg = 0.05,
+         translation_sigma_m = 0.02, max_sigma_m = 0.1;
+};
+
+std::vector<hand_eye::RefineOptions::Fixed> parse_fixes(const std::vector<std::string>& specs) {
+  std::vector<hand_eye::RefineOptions::Fixed> out;
+  for (const std::string& s : specs) {
+    const size_t eq = s.find('=');
+    const std::string axis = s.substr(0, eq);
+    Eigen::Vector3d d = Eigen::Vector3d::Zero();
+    if (axis == "x") d.x() = 1;
+    if (axis == "y") d.y() = 1;
+    if (axis == "z") d.z() = 1;
+    double v = 0;
+    try {
+      size_t used = 0;
+      if (eq == std::string::npos) throw std::invalid_argument("");
+      v = std::stod(s.substr(eq + 1), &used);
+      if (used != s.size() - eq - 1) throw std::invalid_argument("");
+    } catch (const std::exception&) {
+      d.setZero();
+    }
+    if (d.isZero())
+      throw Error(fmt::format("--fix '{}': expected x=METRES, y=METRES or z=METRES", s));
+    out.push_back({d, v});
+  }
+  return out;
+}
+
+nlohmann::json vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+void run(const Options& o) {
+  if (!o.out.empty() && o.rig.empty())
+    throw Error("--out writes the sensor's T_b into --rig: give it");
+  rig::Rig rig;
+  double offset_s = 0.0;
+  SE3 T_base_lidar;
+  std::optional<SE3> prior_T_gnss_lidar;
+  if (!o.rig.empty()) {
+    rig = rig::read_rig_file(o.rig);
+    const rig::Sensor* g = rig::find_sensor(rig, o.sensor);
+    const rig::Sensor* l = rig::find_sensor(rig, o.lidar_sensor);
+    if (!g) throw Error(fmt::format("--sensor {}: no such sensor in {}", o.sensor, o.rig));
+    if (!l)
+      throw Error(fmt::format("--lidar-sensor {}: no such sensor in {}", o.lidar_sensor, o.rig));
+    offset_s = g->time_offset - l->time_offset;
+    T_base_lidar = l->T_base_sensor;
+    prior_T_gnss_lidar = g->T_base_sensor.inverse() * T_base_lidar;
+  }
+  const Trajectory lidar = io::read_trajectory(o.lidar).trajectory;
+  const Trajectory gnss = io::read_trajectory(o.gnss).trajectory;
+  if (lidar.size() < 2 || gnss.size() < 2) throw Error("each trajectory needs at least 2 poses");
+  const Time l0 = lidar.stamps.front(), l1 = lidar.stamps.back();
+  const Time g0 = gnss.stamps.front() + Time::from_seconds(offset_s),
+             g1 = gnss.stamps.back() + Time::from_seconds(offset_s);
+  if (g1 <= l0 || l1 <= g0) {
+    throw Error(fmt::format(
+        "the trajectories do not overlap in time: LiDAR [{}, {}] s, GNSS/INS [{}, {}] s on the "
+        "LiDAR clock (GNSS/INS time_offset {} s): check the clocks and --rig",
+        to_seconds_text(l0), to_seconds_text(l1), to_seconds_text(g0), to_seconds_text(g1),
+        offset_s));
+  }
+  hand_eye::PairOptions po;
+  po.spacing_s = o.spacing_s;
+  po.min_rotation_deg = o.min_rotation_deg;
+  po.time_offset_s = offset_s;
+  const std::vector<hand_eye::MotionPair> pairs = hand_eye::motion_pairs(lidar, gnss, po);
+  if (pairs.size() < 3) {
+    throw Error(fmt::format(
+        "{} motion pairs of {} s rotating at least {} deg: too few or too small motions (at least "
+        "3 are needed; rotate the rig about changing axes, or lower --min-rotation)",
+        pairs.size(), o.spacing_s, o.min_rotation_deg));
+  }
+  const hand_eye::ClosedForm cf = hand_eye::closed_form(pairs, o.max_sigma_m);
+  const hand_eye::Observability& ob = cf.observability;
+
+  // Directions the data do not determine: a --fix along them, or the prior rig's value, or no
+  // answer for them.
+  hand_eye::RefineOptions ro;
+  ro.rotation_sigma_deg = o.rotation_sigma_deg;
+  ro.translation_sigma_m = o.translation_sigma_m;
+  ro.fixed = parse_fixes(o.fix);
+  std::vector<std::string> notes;
+  for (int i : ob.unobservable) {
+    const Eigen::Vector3d d = ob.translation_directions.col(i);
+    bool covered = false;
+    for (const auto& f : ro.fixed) covered |= std::abs(f.direction.dot(d)) > 0.9;
+    if (covered) continue;
+    if (!prior_T_gnss_lidar) {
+      fmt::print(stderr,
+                 "rigcal: the motion does not determine the translation along [{:.3f} {:.3f} "
+                 "{:.3f}] (GNSS/INS frame; 1-sigma {:.3f} m): give --fix (e.g. z=0.35) or a --rig "
+                 "whose extrinsic holds it; nothing written\n",
+                 d.x(), d.y(), d.z(), ob.translation_sigma_m[i]);
+      throw Exit{3};
+    }
+    ro.fixed.push_back({d, d.dot(prior_T_gnss_lidar->t)});
+    notes.push_back(fmt::format(
+        "translation along [{:.3f} {:.3f} {:.3f}] (GNSS/INS frame) is not determined by the "
+        "motion (1-sigma {:.3f} m): kept from the rig, {:.4f} m; give --fix to set it",
+        d.x(), d.y(), d.z(), ob.translation_sigma_m[i], d.dot(prior_T_gnss_lidar->t)));
+  }
+  const hand_eye::Refined r = hand_eye::refine(pairs, cf.T_gnss_lidar, ro);
+  const SE3& X = r.T_gnss_lidar;
+  const Eigen::Vector3d rpy = roll_pitch_yaw(X.R) * 180.0 / M_PI;
+  Eigen::Vector3d sig_r, sig_t;
+  for (int i = 0; i < 3; ++i) {
+    sig_r[i] = std::sqrt(std::max(0.0, r.covariance(i, i))) * 180.0 / M_PI;
+    sig_t[i] = std::sqrt(std::max(0.0, r.covariance(3 + i, 3 + i)));
+  }
+  size_t outliers = 0;
+  for (bool b : r.outlier) outliers += b;
+
+  fmt::print("{} motion pairs of {} s (LiDAR {} poses, GNSS/INS {} poses)\n", pairs.size(),
+             o.spacing_s, lidar.size(), gnss.size());
+  fmt::print(
+      "observability: rotation singular values {:.3f} {:.3f} {:.3f} rad; translation 1-sigma along "
+      "its principal directions {:.4f} {:.4f} {:.4f} m\n",
+      ob.rotation_singular_values[0], ob.rotation_singular_values[1],
+      ob.rotation_singular_values[2], ob.translation_sigma_m[0], ob.translation_sigma_m[1],
+      ob.translation_sigma_m[2]);
+  fmt::print(
+      "T_{}_{}: t = [{:.4f} {:.4f} {:.4f}] ± [{:.4f} {:.4f} {:.4f}] m, roll pitch yaw "
+      "{:.3f} {:.3f} {:.3f} ± {:.3f} {:.3f} {:.3f} deg; {} outlier pairs\n",
+      o.sensor, o.lidar_sensor, X.t.x(), X.t.y(), X.t.z(), sig_t.x(), sig_t.y(), sig_t.z(), rpy.x(),
+      rpy.y(), rpy.z(), sig_r.x(), sig_r.y(), sig_r.z(), outliers);
+  for (const std::string& n : notes) fmt::print("note: {}\n", n);
+
+  std::vector<io::OutputFile> files;
+  if (!o.report.empty()) {
+    nlohmann::json j;
+    j["tool_version"] = version_string();
+    j["definition"] =
+        "T_gnss_lidar: the LiDAR in the GNSS/INS frame; for each pair, A = T_L(t0)^-1 T_L(t1) and "
+        "B = T_G(t0)^-1 T_G(t1) satisfy B X = X A";
+    j["inputs"] = {{"lidar", o.lidar},
+                   {"gnss", o.gnss},
+                   {"rig", o.rig},
+                   {"gnss_time_offset_s", offset_s},
+                   {"spacing_s", o.spacing_s},
+                   {"min_rotation_deg", o.min_rotation_deg}};
+    j["T_gnss_lidar"] = {{"t_m", vec(X.t)},
+                         {"roll_pitch_yaw_deg", vec(rpy)},
+                         {"t_sigma_m", vec(sig_t)},
+                         {"rotation_sigma_deg", vec(sig_r)},
+                         {"matrix", {X.matrix().row(0), X.matrix().row(1), X.matrix().row(2)}}};
+    j["closed_form"] = {{"t_m", vec(cf.T_gnss_lidar.t)},
+                        {"roll_pitch_yaw_deg", vec(roll_pitch_yaw(cf.T_gnss_lidar.R) * 180 / M_PI)},
+                        {"axis_residual_rms_deg", cf.rotation_residual_rms_deg}};
+    nlohmann::json unobs = nlohmann::json::array();
+    for (int i : ob.unobservable) unobs.push_back(vec(ob.translation_directions.col(i)));
+    j["observability"] = {
+        {"rotation_singular_values_rad", vec(ob.rotation_singular_values)},
+        {"translation_singular_values", vec(ob.translation_singular_values)},
+        {"translation_directions",
+         {vec(ob.translation_directions.col(0)), vec(ob.translation_directions.col(1)),
+          vec(ob.translation_directions.col(2))}},
+        {"translation_sigma_m", vec(ob.translation_sigma_m)},
+        {"unobservable_directions", unobs},
+        {"max_sigma_m", o.max_sigma_m}};
+    j["noise_scale"] = r.noise_scale;
+    j["notes"] = notes;
+    nlohmann::json pj = nlohmann::json::array();
+    for (size_t k = 0; k < pairs.size(); ++k) {
+      pj.push_back({{"t0_s", to_seconds_text(pairs[k].t0)},
+                    {"t1_s", to_seconds_text(pairs[k].t1)},
+                    {"rotation_deg", rotation_angle(pairs[k].B.R) * 180 / M_PI},
+                    {"rotation_residual_deg", r.pair_rotation_residual_deg[k]},
+                    {"translation_residual_m", r.pair_translation_residual_m[k]},
+                    {"outlier", static_cast<bool>(r.outlier[k])}});
+    }
+    j["pairs"] = pj;
+    files.push_back({fs::path(o.report) / "hand_eye.json", j.dump(2) + "\n"});
+    // Residuals over time.
+    io::Plot p;
+    p.title = "Per-pair residuals after the solve";
+    p.x_label = "t0 (s since the first pair)";
+    p.y_label = "translation residual (mm)";
+    io::PlotSeries s{"translation", {}, {}, {}};
+    for (size_t k = 0; k < pairs.size(); ++k) {
+      s.x.push_back((pairs[k].t0 - pairs.front().t0).seconds());
+      s.y.push_back(1e3 * r.pair_translation_residual_m[k]);
+    }
+    s.values.assign(s.x.size(), 0.0);
+    p.series = {s};
+    files.push_back({fs::path(o.report) / "residuals.png", io::render_png(p)});
+    // The GNSS/INS positions and the LiDAR odometry carried into the GNSS/INS frame through X,
+    // aligned at the middle pair.
+    const hand_eye::MotionPair& mid = pairs[pairs.size() / 2];
+    io::Plot top;
+    top.title = "Top view: GNSS/INS and LiDAR odometry through the extrinsic";
+    top.x_label = "x (m)";
+    top.y_label = "y (m)";
+    top.equal_axes = true;
+    io::PlotSeries gs{"GNSS/INS", {}, {}, {}}, ls{"LiDAR via X", {}, {}, {}};
+    for (const SE3& T : gnss.T_world_body) gs.x.push_back(T.t.x()), gs.y.push_back(T.t.y());
+    // T_enu_odom from the middle pair's start: T_enu_G(t0) X T_odom_L(t0)^-1.
+    const auto find = [&](const Trajectory& tr, Time t) {
+      const auto it = std::lower_bound(tr.stamps.begin(), tr.stamps.end(), t);
+      return static_cast<size_t>(std::min<ptrdiff_t>(it - tr.stamps.begin(), tr.size() - 1));
+    };
+    const SE3 T_enu_odom = gnss.T_world_body[find(gnss, mid.t0 - Time::from_seconds(offset_s))] *
+                           X * lidar.T_world_body[find(lidar, mid.t0)].inverse();
+    for (const SE3& T : lidar.T_world_body) {
+      const SE3 G = T_enu_odom * T * X.inverse();
+      ls.x.push_back(G.t.x()), ls.y.push_back(G.t.y());
+    }
+    top.series = {gs, ls};
+    files.push_back({fs::path(o.report) / "trajectories.png", io::render_png(top)});
+  }
+  if (!o.out.empty()) {
+    rig::sensor(rig, o.sensor).T_base_sensor = T_base_lidar * X.inverse();
+    files.push_back({o.out, rig::rig_to_yaml(rig)});
+  }
+  io::write_files_atomic(files);
+  if (!o.out.empty()) fmt::print("{}: T_b written to {}\n", o.sensor, o.out);
+  if (!o.report.empty()) fmt::print("report: {}/hand_eye.json and PNGs\n", o.report);
+}
+
+}  // namespace
+
+void add_hand_eye(CLI::App& app) {
+  auto o = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand(
+      "hand-eye",
+      "The GNSS/INS-to-LiDAR extrinsic from the LiDAR odometry and the GNSS/INS trajectory\n"
+      "(doc/hand-eye.md): motion pairs, closed form, robust refinement, covariance, and the\n"
+      "directions the motion does not determine (a car on a plane leaves the vertical offset\n"
+      "free: give --fix z=METRES, or the rig's value is kept and said so). Inputs: TUM, KITTI\n"
+      "with times, EuRoC. Exit 0; 2 on bad input, 3 when a direction is undetermined and\n"
+      "nothing fixes it: nothing written in either case.");
+  cmd->add_option("--lidar", o->lidar, "LiDAR odometry trajectory (T_odom_lidar)")->required();
+  cmd->add_option("--gnss", o->gnss, "GNSS/INS trajectory (T_enu_gnss), on its own clock")
+      ->required();
+  cmd->add_option("--sensor", o->sensor, "the rig's GNSS/INS sensor")->capture_default_str();
+  cmd->add_option("--lidar-sensor", o->lidar_sensor, "the rig's LiDAR")->capture_default_str();
+  cmd->add_option("--rig", o->rig, "rig: clock offsets, prior extrinsic; updated with --out");
+  cmd->add_option("--out", o->out, "output calibration YAML (the sensor's T_b)");
+  cmd->add_option("--report", o->report,
+                  "report folder: hand_eye.json, residuals.png, "
+                  "trajectories.png");
+  cmd->add_option("--fix", o->fix, "hold a translation component (GNSS/INS frame): z=0.35");
+  cmd->add_option("--spacing", o->spacing_s, "seconds between a pair's two poses")
+      ->capture_default_str();
+  cmd->add_option("--min-rotation", o->min_rotation_deg, "pairs rotating less are dropped (deg)")
+      ->capture_default_str();
+  cmd->add_option("--rotation-sigma", o->rotation_sigma_deg, "per-pair rotation noise (deg)")
+      ->capture_default_str();
+  cmd->add_option("--translation-sigma", o->translation_sigma_m, "per-pair translation noise (m)")
+      ->capture_default_str();
+  cmd->add_option("--max-sigma", o->max_sigma_m,
+                  "a translation direction with a larger 1-sigma is not estimated (m)")
+      ->capture_default_str();
+  cmd->callback([o] { run(*o); });
+}
+
+}  // namespace rigcal::cli
