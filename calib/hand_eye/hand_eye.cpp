@@ -132,6 +132,10 @@ Refined refine(const std::vector<MotionPair>& pairs, const SE3& initial, const R
     out.covariance.block<3, 3>(3, 3) = tt;
     out.covariance *= out.noise_scale * out.noise_scale;
   }
+  for (int i = 0; i < 3; ++i) {
+    out.rotation_sigma_deg[i] = std::sqrt(std::max(0.0, out.covariance(i, i))) * 180.0 / M_PI;
+    out.translation_sigma_m[i] = std::sqrt(std::max(0.0, out.covariance(3 + i, 3 + i)));
+  }
   return out;
 }
 

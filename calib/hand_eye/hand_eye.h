@@ -88,6 +88,9 @@ struct Refined {
   // 6 x 6 covariance: rotation (left tangent, rad: R = exp(d) R_X) then translation (m), scaled
   // by the noise estimated from the residuals; fixed directions have (near) zero variance.
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  // Its diagonal as 1-sigmas: about the GNSS/INS frame's axes (deg), and of t (m).
+  Eigen::Vector3d rotation_sigma_deg = Eigen::Vector3d::Zero();
+  Eigen::Vector3d translation_sigma_m = Eigen::Vector3d::Zero();
   std::vector<double> pair_rotation_residual_deg, pair_translation_residual_m;
   std::vector<bool> outlier;  // beyond the 99.9 % of chi-square(6) at the residuals' level
   double noise_scale = 1.0;   // RMS of the normalized residuals: the sigmas' correction factor

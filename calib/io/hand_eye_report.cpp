@@ -1,0 +1,112 @@
+#include "rigcal/io/hand_eye_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "rigcal/core/version.h"
+#include "rigcal/io/svg_plot.h"
+
+namespace rigcal::io {
+namespace {
+
+nlohmann::json vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+}  // namespace
+
+std::vector<OutputFile> hand_eye_report_files(const std::filesystem::path& dir,
+                                              const HandEyeInputs& in,
+                                              const std::vector<hand_eye::MotionPair>& pairs,
+                                              const hand_eye::ClosedForm& cf,
+                                              const hand_eye::Refined& r, const Trajectory& lidar,
+                                              const Trajectory& gnss) {
+  std::vector<OutputFile> files;
+  const hand_eye::Observability& ob = cf.observability;
+  const SE3& X = r.T_gnss_lidar;
+  const Eigen::Vector3d rpy = roll_pitch_yaw(X.R) * 180.0 / M_PI;
+  const Eigen::Vector3d &sig_r = r.rotation_sigma_deg, &sig_t = r.translation_sigma_m;
+  const std::vector<std::string>& notes = in.notes;
+  nlohmann::json j;
+  j["tool_version"] = version_string();
+  j["definition"] =
+      "T_gnss_lidar: the LiDAR in the GNSS/INS frame; for each pair, A = T_L(t0)^-1 T_L(t1) and "
+      "B = T_G(t0)^-1 T_G(t1) satisfy B X = X A";
+  j["inputs"] = {{"lidar", in.lidar},
+                 {"gnss", in.gnss},
+                 {"rig", in.rig},
+                 {"gnss_time_offset_s", in.gnss_time_offset_s},
+                 {"spacing_s", in.spacing_s},
+                 {"min_rotation_deg", in.min_rotation_deg}};
+  j["T_gnss_lidar"] = {{"t_m", vec(X.t)},
+                       {"roll_pitch_yaw_deg", vec(rpy)},
+                       {"t_sigma_m", vec(sig_t)},
+                       {"rotation_sigma_deg", vec(sig_r)},
+                       {"matrix", {X.matrix().row(0), X.matrix().row(1), X.matrix().row(2)}}};
+  j["closed_form"] = {{"t_m", vec(cf.T_gnss_lidar.t)},
+                      {"roll_pitch_yaw_deg", vec(roll_pitch_yaw(cf.T_gnss_lidar.R) * 180 / M_PI)},
+                      {"axis_residual_rms_deg", cf.rotation_residual_rms_deg}};
+  nlohmann::json unobs = nlohmann::json::array();
+  for (int i : ob.unobservable) unobs.push_back(vec(ob.translation_directions.col(i)));
+  j["observability"] = {
+      {"rotation_singular_values_rad", vec(ob.rotation_singular_values)},
+      {"translation_singular_values", vec(ob.translation_singular_values)},
+      {"translation_directions",
+       {vec(ob.translation_directions.col(0)), vec(ob.translation_directions.col(1)),
+        vec(ob.translation_directions.col(2))}},
+      {"translation_sigma_m", vec(ob.translation_sigma_m)},
+      {"unobservable_directions", unobs},
+      {"max_sigma_m", in.max_sigma_m}};
+  j["noise_scale"] = r.noise_scale;
+  j["notes"] = notes;
+  nlohmann::json pj = nlohmann::json::array();
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    pj.push_back({{"t0_s", to_seconds_text(pairs[k].t0)},
+                  {"t1_s", to_seconds_text(pairs[k].t1)},
+                  {"rotation_deg", rotation_angle(pairs[k].B.R) * 180 / M_PI},
+                  {"rotation_residual_deg", r.pair_rotation_residual_deg[k]},
+                  {"translation_residual_m", r.pair_translation_residual_m[k]},
+                  {"outlier", static_cast<bool>(r.outlier[k])}});
+  }
+  j["pairs"] = pj;
+  files.push_back({dir / "hand_eye.json", j.dump(2) + "\n"});
+  // Residuals over time.
+  Plot p;
+  p.title = "Per-pair residuals after the solve";
+  p.x_label = "t0 (s since the first pair)";
+  p.y_label = "translation residual (mm)";
+  PlotSeries s{"translation", {}, {}, {}};
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    s.x.push_back((pairs[k].t0 - pairs.front().t0).seconds());
+    s.y.push_back(1e3 * r.pair_translation_residual_m[k]);
+  }
+  s.values.assign(s.x.size(), 0.0);
+  p.series = {s};
+  files.push_back({dir / "residuals.png", render_png(p)});
+  // The GNSS/INS positions and the LiDAR odometry carried into the GNSS/INS frame through X,
+  // aligned at the middle pair.
+  const hand_eye::MotionPair& mid = pairs[pairs.size() / 2];
+  Plot top;
+  top.title = "Top view: GNSS/INS and LiDAR odometry through the extrinsic";
+  top.x_label = "x (m)";
+  top.y_label = "y (m)";
+  top.equal_axes = true;
+  PlotSeries gs{"GNSS/INS", {}, {}, {}}, ls{"LiDAR via X", {}, {}, {}};
+  for (const SE3& T : gnss.T_world_body) gs.x.push_back(T.t.x()), gs.y.push_back(T.t.y());
+  // T_enu_odom from the middle pair's start: T_enu_G(t0) X T_odom_L(t0)^-1.
+  const auto find = [&](const Trajectory& tr, Time t) {
+    const auto it = std::lower_bound(tr.stamps.begin(), tr.stamps.end(), t);
+    return static_cast<size_t>(std::min<ptrdiff_t>(it - tr.stamps.begin(), tr.size() - 1));
+  };
+  const SE3 T_enu_odom =
+      gnss.T_world_body[find(gnss, mid.t0 - Time::from_seconds(in.gnss_time_offset_s))] * X *
+      lidar.T_world_body[find(lidar, mid.t0)].inverse();
+  for (const SE3& T : lidar.T_world_body) {
+    const SE3 G = T_enu_odom * T * X.inverse();
+    ls.x.push_back(G.t.x()), ls.y.push_back(G.t.y());
+  }
+  top.series = {gs, ls};
+  files.push_back({dir / "trajectories.png", render_png(top)});
+  return files;
+}
+
+}  // namespace rigcal::io

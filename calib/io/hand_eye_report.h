@@ -1,0 +1,28 @@
+#pragma once
+// The hand-eye report (doc/hand-eye.md): hand_eye.json (every figure with its definition),
+// residuals.png (per-pair residuals against time) and trajectories.png (top view of the GNSS/INS
+// positions and of the LiDAR odometry carried into the GNSS/INS frame through the extrinsic).
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "rigcal/core/trajectory.h"
+#include "rigcal/hand_eye/hand_eye.h"
+#include "rigcal/io/files.h"
+
+namespace rigcal::io {
+
+struct HandEyeInputs {
+  std::string lidar, gnss, rig;  // paths as given
+  double gnss_time_offset_s = 0.0, spacing_s = 0.0, min_rotation_deg = 0.0, max_sigma_m = 0.0;
+  std::vector<std::string> notes;
+};
+
+std::vector<OutputFile> hand_eye_report_files(const std::filesystem::path& dir,
+                                              const HandEyeInputs& in,
+                                              const std::vector<hand_eye::MotionPair>& pairs,
+                                              const hand_eye::ClosedForm& cf,
+                                              const hand_eye::Refined& r, const Trajectory& lidar,
+                                              const Trajectory& gnss);
+
+}  // namespace rigcal::io
