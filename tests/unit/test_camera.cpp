@@ -260,8 +260,11 @@ TEST(CameraSim, RadtanMeetsTheTruthBar) { check_against_truth(kRadtan, 1, true);
 TEST(CameraSim, EquidistantMeetsTheTruthBar) { check_against_truth(kEquidistant, 1, true); }
 
 // The same 40 views with the 6 x 6 AprilGrid (88 mm tags, 144 corners a view where the A3 board
-// has 40): more information a view, so the issue's bars themselves are asserted.
-TEST(CameraSim, AprilGridMeetsTheIssuesBars) {
+// has 40): the issue's bars asserted for seed 1, which meets them. Not in general: over seeds 1-8
+// the rotation bar holds in 4 (0.0038-0.0165 deg), the principal point in 7, focal and baseline
+// in 8, and the centre pixel's projection error reaches 0.6-5.6 mrcal-style sigmas
+// (doc/cameras.md): AprilGrid corners carry errors that are not independent noise.
+TEST(CameraSim, AprilGridSeedOneAgainstTheIssuesBars) {
   SimCase sc = kRadtan;
   sc.target_file = RIGCAL_SOURCE_DIR "/targets/aprilgrid_6x6_88mm.yaml";
   const TruthZ t = check_against_truth(sc, 1, true);
