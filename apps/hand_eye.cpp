@@ -14,6 +14,7 @@
 #include "rigcal/io/hand_eye_report.h"
 #include "rigcal/io/trajectory_io.h"
 #include "rigcal/rig/rig_yaml.h"
+#include "rigcal/time_sync/time_sync.h"
 
 namespace rigcal::cli {
 namespace {
@@ -25,6 +26,7 @@ struct Options {
   std::vector<std::string> fix;  // AXIS=VALUE, GNSS/INS frame
   double spacing_s = 1.0, min_rotation_deg = 1.0, rotation_sigma_deg = 0.05,
          translation_sigma_m = 0.02, max_sigma_m = 0.1;
+  bool estimate_offset = false;
 };
 
 std::vector<hand_eye::RefineOptions::Fixed> parse_fixes(const std::vector<std::string>& specs) {
@@ -73,6 +75,23 @@ void run(const Options& o) {
   const Trajectory lidar = io::read_trajectory(o.lidar).trajectory;
   const Trajectory gnss = io::read_trajectory(o.gnss).trajectory;
   if (lidar.size() < 2 || gnss.size() < 2) throw Error("each trajectory needs at least 2 poses");
+  std::optional<time_sync::TimeSyncResult> sync;
+  if (o.estimate_offset) {
+    // The clock offset from the two trajectories' angular velocities (doc/time-offset.md), around
+    // the rig's value: t_lidar = t_gnss + offset.
+    time_sync::AngularRates gnss_rates = time_sync::angular_rates_from_trajectory(gnss);
+    for (Time& t : gnss_rates.stamps) t = t + Time::from_seconds(offset_s);
+    sync = time_sync::estimate_time_offset(time_sync::angular_rates_from_trajectory(lidar),
+                                           gnss_rates);
+    if (sync->verdict != "ok") {
+      fmt::print(stderr, "rigcal: the clock offset cannot be estimated: {}: {}; nothing written\n",
+                 sync->verdict, sync->reason);
+      throw Exit{3};
+    }
+    offset_s += sync->offset_s;
+    fmt::print("clock offset: t_lidar = t_gnss + {:.6f} s (1-sigma {:.3f} ms, NCC {:.3f})\n",
+               offset_s, 1e3 * sync->sigma_s, sync->peak_ncc);
+  }
   const Time l0 = lidar.stamps.front(), l1 = lidar.stamps.back();
   const Time g0 = gnss.stamps.front() + Time::from_seconds(offset_s),
              g1 = gnss.stamps.back() + Time::from_seconds(offset_s);
@@ -104,6 +123,12 @@ void run(const Options& o) {
   ro.translation_sigma_m = o.translation_sigma_m;
   ro.fixed = parse_fixes(o.fix);
   std::vector<std::string> notes;
+  if (sync) {
+    notes.push_back(fmt::format(
+        "clock offset estimated from the trajectories' angular velocities: t_lidar = t_gnss + "
+        "{:.6f} s, 1-sigma {:.6f} s, peak NCC {:.3f}",
+        offset_s, sync->sigma_s, sync->peak_ncc));
+  }
   for (int i : ob.unobservable) {
     const Eigen::Vector3d d = ob.translation_directions.col(i);
     bool covered = false;
@@ -153,6 +178,10 @@ void run(const Options& o) {
   }
   if (!o.out.empty()) {
     rig::sensor(rig, o.sensor).T_base_sensor = T_base_lidar * X.inverse();
+    if (sync) {
+      rig::Sensor& g = rig::sensor(rig, o.sensor);
+      g.time_offset = rig::sensor(rig, o.lidar_sensor).time_offset + offset_s;
+    }
     files.push_back({o.out, rig::rig_to_yaml(rig)});
   }
   io::write_files_atomic(files);
@@ -183,6 +212,9 @@ void add_hand_eye(CLI::App& app) {
                   "report folder: hand_eye.json, residuals.png, "
                   "trajectories.png");
   cmd->add_option("--fix", o->fix, "hold a translation component (GNSS/INS frame): z=0.35");
+  cmd->add_flag("--estimate-offset", o->estimate_offset,
+                "estimate the clock offset from the trajectories' angular velocities (around "
+                "the rig's value, +-1 s) and write it as the sensor's time_offset");
   cmd->add_option("--spacing", o->spacing_s, "seconds between a pair's two poses")
       ->capture_default_str();
   cmd->add_option("--min-rotation", o->min_rotation_deg, "pairs rotating less are dropped (deg)")
