@@ -4,12 +4,13 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <filesystem>
 #include <memory>
+#include <optional>
 
 #include "cli.h"
 #include "rigcal/core/error.h"
 #include "rigcal/core/se3.h"
+#include "rigcal/core/text.h"
 #include "rigcal/io/files.h"
 #include "rigcal/io/hand_eye_report.h"
 #include "rigcal/io/trajectory_io.h"
@@ -18,8 +19,6 @@
 
 namespace rigcal::cli {
 namespace {
-
-namespace fs = std::filesystem;
 
 struct Options {
   std::string lidar, gnss, sensor = "gnss", lidar_sensor = "lidar", rig, out, report;
@@ -40,11 +39,9 @@ std::vector<hand_eye::RefineOptions::Fixed> parse_fixes(const std::vector<std::s
     if (axis == "z") d.z() = 1;
     double v = 0;
     try {
-      size_t used = 0;
-      if (eq == std::string::npos) throw std::invalid_argument("");
-      v = std::stod(s.substr(eq + 1), &used);
-      if (used != s.size() - eq - 1) throw std::invalid_argument("");
-    } catch (const std::exception&) {
+      if (eq == std::string::npos) throw Error("");
+      v = parse_double(std::string_view(s).substr(eq + 1), "--fix");
+    } catch (const Error&) {
       d.setZero();
     }
     if (d.isZero())
@@ -129,20 +126,18 @@ void run(const Options& o) {
         "{:.6f} s, 1-sigma {:.6f} s, peak NCC {:.3f}",
         offset_s, sync->sigma_s, sync->peak_ncc));
   }
-  for (int i : ob.unobservable) {
+  const hand_eye::Held held = hand_eye::hold_unobservable(ob, prior_T_gnss_lidar, ro.fixed);
+  for (int i : held.uncovered) {
     const Eigen::Vector3d d = ob.translation_directions.col(i);
-    bool covered = false;
-    for (const auto& f : ro.fixed) covered |= std::abs(f.direction.dot(d)) > 0.9;
-    if (covered) continue;
-    if (!prior_T_gnss_lidar) {
-      fmt::print(stderr,
-                 "rigcal: the motion does not determine the translation along [{:.3f} {:.3f} "
-                 "{:.3f}] (GNSS/INS frame; 1-sigma {:.3f} m): give --fix (e.g. z=0.35) or a --rig "
-                 "whose extrinsic holds it; nothing written\n",
-                 d.x(), d.y(), d.z(), ob.translation_sigma_m[i]);
-      throw Exit{3};
-    }
-    ro.fixed.push_back({d, d.dot(prior_T_gnss_lidar->t)});
+    fmt::print(stderr,
+               "rigcal: the motion does not determine the translation along [{:.3f} {:.3f} "
+               "{:.3f}] (GNSS/INS frame; 1-sigma {:.3f} m): give --fix (e.g. z=0.35) or a --rig "
+               "whose extrinsic holds it; nothing written\n",
+               d.x(), d.y(), d.z(), ob.translation_sigma_m[i]);
+  }
+  if (!held.uncovered.empty()) throw Exit{3};
+  for (int i : held.from_prior) {
+    const Eigen::Vector3d d = ob.translation_directions.col(i);
     notes.push_back(fmt::format(
         "translation along [{:.3f} {:.3f} {:.3f}] (GNSS/INS frame) is not determined by the "
         "motion (1-sigma {:.3f} m): kept from the rig, {:.4f} m; give --fix to set it",
@@ -178,10 +173,7 @@ void run(const Options& o) {
   }
   if (!o.out.empty()) {
     rig::sensor(rig, o.sensor).T_base_sensor = T_base_lidar * X.inverse();
-    if (sync) {
-      rig::Sensor& g = rig::sensor(rig, o.sensor);
-      g.time_offset = rig::sensor(rig, o.lidar_sensor).time_offset + offset_s;
-    }
+    if (sync) rig::set_clock_from(rig, o.sensor, o.lidar_sensor, offset_s);
     files.push_back({o.out, rig::rig_to_yaml(rig)});
   }
   io::write_files_atomic(files);

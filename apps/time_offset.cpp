@@ -10,6 +10,7 @@
 #include "cli.h"
 #include "rigcal/core/error.h"
 #include "rigcal/core/se3.h"
+#include "rigcal/core/text.h"
 #include "rigcal/core/time.h"
 #include "rigcal/io/files.h"
 #include "rigcal/io/rates_io.h"
@@ -66,13 +67,13 @@ void run(Options o) {
     topt.max_offset_s = std::numeric_limits<double>::infinity();
   } else {
     try {
-      size_t used = 0;
-      topt.max_offset_s = std::stod(o.max_offset, &used);
-      if (used != o.max_offset.size() || !(topt.max_offset_s > 0)) throw std::invalid_argument("");
-    } catch (const std::exception&) {
+      topt.max_offset_s = parse_double(o.max_offset, "--max-offset");
+    } catch (const Error&) {
+      topt.max_offset_s = 0;
+    }
+    if (!(topt.max_offset_s > 0))
       throw Error(
           fmt::format("--max-offset: expected seconds > 0 or 'all', got '{}'", o.max_offset));
-    }
   }
   if (!(o.min_overlap > 0 && o.min_overlap <= 1))
     throw Error(fmt::format("--min-overlap: expected a fraction in (0, 1], got {}", o.min_overlap));
@@ -87,8 +88,6 @@ void run(Options o) {
   io::TimeSyncInputs in;
   in.reference = o.reference, in.other = o.other;
   in.sensor = o.sensor, in.reference_sensor = o.reference_sensor;
-  double reference_drift_ppm = 0.0;
-  Time reference_drift_epoch;
   if (!o.rig.empty()) {
     rig = rig::read_rig_file(o.rig);
     if (!o.sensor.empty() && !rig::find_sensor(rig, o.sensor))
@@ -99,8 +98,6 @@ void run(Options o) {
         throw Error(
             fmt::format("--reference-sensor {}: no such sensor in {}", o.reference_sensor, o.rig));
       in.reference_time_offset_s = ref->time_offset;
-      if (ref->time_drift_ppm)
-        reference_drift_ppm = *ref->time_drift_ppm, reference_drift_epoch = ref->time_drift_epoch;
     }
   }
   if (o.reference_sensor.empty())
@@ -152,21 +149,8 @@ void run(Options o) {
   }
 
   if (!o.out.empty()) {
-    rig::Sensor& s = rig::sensor(rig, o.sensor);
-    // t_base = t_ref + off_ref + d_ref (t_ref - e_ref), t_ref = t + off + d (t - e): to first
-    // order in the drifts, offset off_ref + off + d_ref (e + off - e_ref) at e, drift d + d_ref.
-    const Time e = r.epoch;
-    const double d = r.drift_significant ? r.drift_ppm : 0.0;
-    s.time_offset =
-        in.reference_time_offset_s + r.offset_s +
-        reference_drift_ppm * 1e-6 * ((e - reference_drift_epoch).seconds() + r.offset_s);
-    if (d != 0.0 || reference_drift_ppm != 0.0) {
-      s.time_drift_ppm = d + reference_drift_ppm;
-      s.time_drift_epoch = e;
-    } else {
-      s.time_drift_ppm.reset();
-      s.time_drift_epoch = Time{};
-    }
+    rig::set_clock_from(rig, o.sensor, o.reference_sensor, r.offset_s,
+                        r.drift_significant ? r.drift_ppm : 0.0, r.epoch);
     files.push_back({o.out, rig::rig_to_yaml(rig)});
   }
   io::write_files_atomic(files);

@@ -61,6 +61,24 @@ struct FixedError {
 
 }  // namespace
 
+Held hold_unobservable(const Observability& ob, const std::optional<SE3>& prior,
+                       std::vector<RefineOptions::Fixed>& fixed) {
+  Held held;
+  for (int i : ob.unobservable) {
+    const Eigen::Vector3d d = ob.translation_directions.col(i);
+    bool covered = false;
+    for (const RefineOptions::Fixed& f : fixed) covered |= std::abs(f.direction.dot(d)) > 0.9;
+    if (covered) continue;
+    if (!prior) {
+      held.uncovered.push_back(i);
+      continue;
+    }
+    fixed.push_back({d, d.dot(prior->t)});
+    held.from_prior.push_back(i);
+  }
+  return held;
+}
+
 Refined refine(const std::vector<MotionPair>& pairs, const SE3& initial, const RefineOptions& o) {
   if (pairs.size() < 3)
     throw Error(fmt::format("{} motion pairs; at least 3 are needed", pairs.size()));

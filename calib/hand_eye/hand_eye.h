@@ -10,6 +10,7 @@
 // plane turns about the vertical) leaves the rotation about that axis poorly determined and the
 // translation along it not at all; Observability says so in numbers.
 #include <Eigen/Core>
+#include <optional>
 #include <vector>
 
 #include "rigcal/core/se3.h"
@@ -95,6 +96,16 @@ struct Refined {
   std::vector<bool> outlier;  // beyond the 99.9 % of chi-square(6) at the residuals' level
   double noise_scale = 1.0;   // RMS of the normalized residuals: the sigmas' correction factor
 };
+
+// The unobservable directions of `observability` that no entry of `fixed` covers (|cos| > 0.9)
+// are appended to `fixed`, held at the prior extrinsic's component. Returns the indices (columns
+// of translation_directions) so held; without a prior, throws nothing and appends nothing but
+// returns them in `uncovered` instead.
+struct Held {
+  std::vector<int> from_prior, uncovered;
+};
+Held hold_unobservable(const Observability& observability, const std::optional<SE3>& prior,
+                       std::vector<RefineOptions::Fixed>& fixed);
 
 // Nonlinear least squares over X from `initial` (Ceres, Huber loss): all pairs' rotation and
 // translation residuals together, unlike the closed form's two separate steps.

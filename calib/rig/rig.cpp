@@ -153,6 +153,29 @@ std::vector<Problem> find_problems(const Rig& rig) {
   return out;
 }
 
+void set_clock_from(Rig& rig, std::string_view sensor_name, std::string_view reference,
+                    double offset_s, double drift_ppm, Time epoch) {
+  double ref_offset = 0.0, ref_drift = 0.0;
+  Time ref_epoch;
+  if (!reference.empty()) {
+    const Sensor& r = sensor(rig, reference);
+    ref_offset = r.time_offset;
+    if (r.time_drift_ppm) ref_drift = *r.time_drift_ppm, ref_epoch = r.time_drift_epoch;
+  }
+  // t_base = t_ref + off_ref + d_ref (t_ref - e_ref), t_ref = t + off + d (t - e): at t = e the
+  // offset is off_ref + off + d_ref (e + off - e_ref); the drift is d + d_ref.
+  Sensor& s = sensor(rig, sensor_name);
+  s.time_offset =
+      ref_offset + offset_s + ref_drift * 1e-6 * ((epoch - ref_epoch).seconds() + offset_s);
+  if (drift_ppm != 0.0 || ref_drift != 0.0) {
+    s.time_drift_ppm = drift_ppm + ref_drift;
+    s.time_drift_epoch = epoch;
+  } else {
+    s.time_drift_ppm.reset();
+    s.time_drift_epoch = Time{};
+  }
+}
+
 void validate(const Rig& rig) {
   const std::vector<Problem> problems = find_problems(rig);
   if (!problems.empty()) {

@@ -90,6 +90,14 @@ std::vector<const Sensor*> cameras(const Rig& rig);
 // T_a_b = inv(a.T_b) * b.T_b. Example: T_a_b(rig, "cam_l", "lidar") is T_cam_l_lidar.
 SE3 T_a_b(const Rig& rig, std::string_view a, std::string_view b);
 
+// Sets `sensor`'s clock from a measurement against another clock,
+//     t_reference = t_sensor + offset_s + drift_ppm * 1e-6 * (t_sensor - epoch),
+// where the reference is sensor `reference` (its own time_offset and drift composed in, to first
+// order in the drifts) or, when `reference` is empty, the base clock. The drift keys are set where
+// the composed drift is not zero and removed where it is.
+void set_clock_from(Rig& rig, std::string_view sensor, std::string_view reference, double offset_s,
+                    double drift_ppm = 0.0, Time epoch = {});
+
 // Checks the rig as a whole (also run by the YAML writer). Throws rigcal::Error with the first
 // problem, naming sensor and key: duplicate names, bad intrinsics, non-rotations, unknown base.
 void validate(const Rig& rig);

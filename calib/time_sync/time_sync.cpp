@@ -8,6 +8,7 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <climits>
+#include <cstdint>
 #include <cmath>
 #include <limits>
 #include <opencv2/core.hpp>
@@ -348,11 +349,12 @@ struct Pairing {
   double fast_time(double t_slow, double d) const {
     return slow_is_reference ? t_slow - d : t_slow + d;
   }
-  // Calls f(w_ref, w_other, index in points) for every pair that can be interpolated.
+  // Calls f(w_ref, w_other, index in points) for every pair with index in [q0, q1) that can be
+  // interpolated; returns how many.
   template <class F>
-  size_t for_each(double d, F f) const {
+  size_t for_each(double d, F f, size_t q0 = 0, size_t q1 = SIZE_MAX) const {
     size_t hint = 0, n = 0;
-    for (size_t q = 0; q < points.size(); ++q) {
+    for (size_t q = q0; q < std::min(q1, points.size()); ++q) {
       const size_t i = points[q];
       Eigen::Vector3d w;
       if (!sample(*fast, fast_time(slow->t[i], d), hint, w)) continue;
@@ -371,18 +373,9 @@ struct Pairing {
   template <class Acc, class F>
   Acc reduce(double d, F f) const {
     auto run = [&](size_t q0, size_t q1, Acc acc) {
-      size_t hint = 0;
-      for (size_t q = q0; q < q1; ++q) {
-        const size_t i = points[q];
-        Eigen::Vector3d w;
-        if (!sample(*fast, fast_time(slow->t[i], d), hint, w)) continue;
-        if (slow_is_reference) {
-          f(acc, slow->w[i], w);
-        } else {
-          f(acc, w, slow->w[i]);
-        }
-        ++acc.n;
-      }
+      acc.n += for_each(
+          d, [&](const Eigen::Vector3d& wr, const Eigen::Vector3d& wo, size_t) { f(acc, wr, wo); },
+          q0, q1);
       return acc;
     };
     constexpr size_t kChunk = 16384;
