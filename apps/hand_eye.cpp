@@ -15,7 +15,6 @@
 #include "rigcal/io/hand_eye_report.h"
 #include "rigcal/io/trajectory_io.h"
 #include "rigcal/rig/rig_yaml.h"
-#include "rigcal/time_sync/time_sync.h"
 
 namespace rigcal::cli {
 namespace {
@@ -24,7 +23,7 @@ struct Options {
   std::string lidar, gnss, sensor = "gnss", lidar_sensor = "lidar", rig, out, report;
   std::vector<std::string> fix;  // AXIS=VALUE, GNSS/INS frame
   double spacing_s = 1.0, min_rotation_deg = 1.0, rotation_sigma_deg = 0.05,
-         translation_sigma_m = 0.02, max_sigma_m = 0.1;
+         translation_sigma_m = 0.02, max_sigma_m = 0.05;
   bool estimate_offset = false;
 };
 
@@ -76,16 +75,13 @@ void run(const Options& o) {
   if (o.estimate_offset) {
     // The clock offset from the two trajectories' angular velocities (doc/time-offset.md), around
     // the rig's value: t_lidar = t_gnss + offset.
-    time_sync::AngularRates gnss_rates = time_sync::angular_rates_from_trajectory(gnss);
-    for (Time& t : gnss_rates.stamps) t = t + Time::from_seconds(offset_s);
-    sync = time_sync::estimate_time_offset(time_sync::angular_rates_from_trajectory(lidar),
-                                           gnss_rates);
+    sync = hand_eye::estimate_clock_offset(lidar, gnss, offset_s);
     if (sync->verdict != "ok") {
       fmt::print(stderr, "rigcal: the clock offset cannot be estimated: {}: {}; nothing written\n",
                  sync->verdict, sync->reason);
       throw Exit{3};
     }
-    offset_s += sync->offset_s;
+    offset_s = sync->offset_s;
     fmt::print("clock offset: t_lidar = t_gnss + {:.6f} s (1-sigma {:.3f} ms, NCC {:.3f})\n",
                offset_s, 1e3 * sync->sigma_s, sync->peak_ncc);
   }
@@ -125,6 +121,16 @@ void run(const Options& o) {
         "clock offset estimated from the trajectories' angular velocities: t_lidar = t_gnss + "
         "{:.6f} s, 1-sigma {:.6f} s, peak NCC {:.3f}",
         offset_s, sync->sigma_s, sync->peak_ncc));
+  }
+  if (ob.near_planar) {
+    const Eigen::Vector3d& n = ob.dominant_axis;
+    notes.push_back(fmt::format(
+        "near-planar motion: the rotation axes stay within a narrow cone about [{:.3f} {:.3f} "
+        "{:.3f}] (GNSS/INS frame; rotation singular values {:.3f} {:.3f} {:.3f} rad, the third "
+        "below {} of the first): the rotation about it is poorly conditioned and the translation "
+        "along it weakly determined (1-sigma below)",
+        n.x(), n.y(), n.z(), ob.rotation_singular_values[0], ob.rotation_singular_values[1],
+        ob.rotation_singular_values[2], hand_eye::kNearPlanarRatio));
   }
   const hand_eye::Held held = hand_eye::hold_unobservable(ob, prior_T_gnss_lidar, ro.fixed);
   for (int i : held.uncovered) {

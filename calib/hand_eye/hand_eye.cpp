@@ -61,6 +61,16 @@ struct FixedError {
 
 }  // namespace
 
+time_sync::TimeSyncResult estimate_clock_offset(const Trajectory& lidar, const Trajectory& gnss,
+                                                double prior_offset_s) {
+  time_sync::AngularRates gnss_rates = time_sync::angular_rates_from_trajectory(gnss);
+  for (Time& t : gnss_rates.stamps) t = t + Time::from_seconds(prior_offset_s);
+  time_sync::TimeSyncResult r =
+      time_sync::estimate_time_offset(time_sync::angular_rates_from_trajectory(lidar), gnss_rates);
+  r.offset_s += prior_offset_s;
+  return r;
+}
+
 Held hold_unobservable(const Observability& ob, const std::optional<SE3>& prior,
                        std::vector<RefineOptions::Fixed>& fixed) {
   Held held;
@@ -162,6 +172,7 @@ std::vector<MotionPair> motion_pairs(const Trajectory& lidar, const Trajectory& 
   std::vector<MotionPair> pairs;
   const Time offset = Time::from_seconds(o.time_offset_s);
   const Time spacing = Time::from_seconds(o.spacing_s), max_gap = Time::from_seconds(o.max_gap_s);
+  const Time stride = o.stride_s > 0 ? Time::from_seconds(o.stride_s) : spacing;
   const double min_rotation = o.min_rotation_deg * M_PI / 180.0;
   size_t i = 0;
   while (i < gnss.size()) {
@@ -177,7 +188,11 @@ std::vector<MotionPair> motion_pairs(const Trajectory& lidar, const Trajectory& 
         rotation_angle(B.R) >= min_rotation) {
       pairs.push_back({t0, t1, L0->inverse() * *L1, B});
     }
-    i = j;
+    i = stride == spacing
+            ? j
+            : static_cast<size_t>(std::lower_bound(gnss.stamps.begin() + i + 1, gnss.stamps.end(),
+                                                   gnss.stamps[i] + stride) -
+                                  gnss.stamps.begin());
   }
   return pairs;
 }
@@ -200,8 +215,13 @@ ClosedForm closed_form(const std::vector<MotionPair>& pairs, double max_sigma_m)
   Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
   D(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1.0 : 1.0;
   const Eigen::Matrix3d R = svd.matrixU() * D * svd.matrixV().transpose();
-  out.observability.rotation_singular_values =
-      Eigen::JacobiSVD<Eigen::Matrix3d>(S).singularValues().cwiseSqrt();
+  const Eigen::JacobiSVD<Eigen::Matrix3d> axes(S, Eigen::ComputeFullU);
+  Observability& ob = out.observability;
+  ob.rotation_singular_values = axes.singularValues().cwiseSqrt();
+  ob.near_planar =
+      ob.rotation_singular_values[2] < kNearPlanarRatio * ob.rotation_singular_values[0];
+  ob.dominant_axis = R * axes.matrixU().col(0);
+  if (ob.dominant_axis.z() < 0) ob.dominant_axis = -ob.dominant_axis;
   double sse = 0;
   for (const MotionPair& p : pairs) {
     sse += (rotation_vector(p.B.R) - R * rotation_vector(p.A.R)).squaredNorm();
@@ -224,9 +244,17 @@ ClosedForm closed_form(const std::vector<MotionPair>& pairs, double max_sigma_m)
   const double sigma_r = std::sqrt((M * t_full - y).squaredNorm() / dof);
   Eigen::Vector3d t = Eigen::Vector3d::Zero();
   const Eigen::VectorXd Uty = ts.matrixU().transpose() * y;
+  // Near-planar motion: the direction closest to the dominant rotation axis is not estimated
+  // whatever its formal sigma (the little it is constrained comes from the vehicle's pitch and
+  // roll, which are not motions a calibration can trust).
+  int normal = -1;
+  if (ob.near_planar) {
+    (ts.matrixV().transpose() * ob.dominant_axis).cwiseAbs().maxCoeff(&normal);
+  }
   for (int i = 0; i < 3; ++i) {
     out.observability.translation_sigma_m[i] = sv[i] > 0 ? sigma_r / sv[i] : INFINITY;
-    if (sv[i] < 1e-3 * sv[0] || out.observability.translation_sigma_m[i] > max_sigma_m) {
+    if (i == normal || sv[i] < 1e-3 * sv[0] ||
+        out.observability.translation_sigma_m[i] > max_sigma_m) {
       out.observability.unobservable.push_back(i);
       continue;
     }

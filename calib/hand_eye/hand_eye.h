@@ -16,6 +16,7 @@
 #include "rigcal/core/se3.h"
 #include "rigcal/core/time.h"
 #include "rigcal/core/trajectory.h"
+#include "rigcal/time_sync/time_sync.h"
 
 namespace rigcal::hand_eye {
 
@@ -26,7 +27,9 @@ struct MotionPair {
 };
 
 struct PairOptions {
-  double spacing_s = 1.0;         // t1 - t0, consecutive pairs (non-overlapping)
+  double spacing_s = 1.0;  // t1 - t0
+  // Between the starts of consecutive pairs; 0: spacing_s (pairs end to end, no shared pose).
+  double stride_s = 0.0;
   double min_rotation_deg = 1.0;  // pairs whose GNSS/INS rotation is smaller are dropped
   // The GNSS/INS clock: t_lidar = t_gnss + time_offset_s (its time_offset in the rig when the
   // LiDAR is on the base clock).
@@ -40,11 +43,26 @@ struct PairOptions {
 std::vector<MotionPair> motion_pairs(const Trajectory& T_odom_lidar, const Trajectory& T_enu_gnss,
                                      const PairOptions& options = {});
 
+// The GNSS/INS clock offset from the two trajectories' angular velocities (the time-offset
+// step's method, doc/time-offset.md), searched around prior_offset_s: t_lidar = t_gnss +
+// offset_s, the prior included in the result's offset_s. Check the verdict before using it.
+time_sync::TimeSyncResult estimate_clock_offset(const Trajectory& T_odom_lidar,
+                                                const Trajectory& T_enu_gnss,
+                                                double prior_offset_s = 0.0);
+
 struct Observability {
   // Singular values (descending) of the stacked rotation vectors of the LiDAR motions, rad: all
   // three large when the motion turns about spread axes; a small third one means one direction
   // of rotation axes is missing.
   Eigen::Vector3d rotation_singular_values = Eigen::Vector3d::Zero();
+  // The motion turns (nearly) about one axis only: the third rotation singular value is below
+  // kNearPlanarRatio of the first (a car on a road: about 0.05; hand-held walking: 0.15-0.45).
+  // Then the rotation about that axis is poorly conditioned and the translation along it is
+  // weakly determined or not at all (translation_sigma_m says how much).
+  bool near_planar = false;
+  // The dominant rotation axis (first principal direction of the rotation vectors), GNSS/INS
+  // frame: the plane's normal when near_planar.
+  Eigen::Vector3d dominant_axis = Eigen::Vector3d::UnitZ();
   // Singular values (descending) of the stacked (R_B - I), and their right singular vectors
   // (columns, GNSS/INS frame): the translation along a column whose value is small is not
   // determined by the data.
@@ -54,10 +72,13 @@ struct Observability {
   // residuals (per coordinate, with the degrees of freedom) over the singular value.
   Eigen::Vector3d translation_sigma_m = Eigen::Vector3d::Zero();
   // Directions (columns of translation_directions) the data do not determine: a 1-sigma above
-  // max_sigma_m, or a singular value below 1e-3 of the largest. Their translation component is
+  // max_sigma_m, a singular value below 1e-3 of the largest, or (near_planar) the one closest to
+  // the dominant rotation axis. Their translation component is
   // set to 0 (minimum norm), not estimated.
   std::vector<int> unobservable;
 };
+
+inline constexpr double kNearPlanarRatio = 0.1;
 
 struct ClosedForm {
   SE3 T_gnss_lidar;
@@ -67,7 +88,7 @@ struct ClosedForm {
 };
 
 // Throws rigcal::Error with fewer than 3 pairs.
-ClosedForm closed_form(const std::vector<MotionPair>& pairs, double max_sigma_m = 0.1);
+ClosedForm closed_form(const std::vector<MotionPair>& pairs, double max_sigma_m = 0.05);
 
 struct RefineOptions {
   // Per-pair noise: a pair's residual is scaled by these (rotation error of R_B R_X vs R_X R_A;

@@ -49,6 +49,9 @@ std::vector<OutputFile> hand_eye_report_files(const std::filesystem::path& dir,
   for (int i : ob.unobservable) unobs.push_back(vec(ob.translation_directions.col(i)));
   j["observability"] = {
       {"rotation_singular_values_rad", vec(ob.rotation_singular_values)},
+      {"near_planar", ob.near_planar},
+      {"near_planar_ratio", hand_eye::kNearPlanarRatio},
+      {"dominant_rotation_axis", vec(ob.dominant_axis)},
       {"translation_singular_values", vec(ob.translation_singular_values)},
       {"translation_directions",
        {vec(ob.translation_directions.col(0)), vec(ob.translation_directions.col(1)),
