@@ -34,18 +34,9 @@ io::TrajectoryReadOptions read_options(const Options& o, const std::string& form
   io::TrajectoryReadOptions r;
   r.format = io::trajectory_format_from_string(format.empty() ? o.format : format);
   r.kitti_times = times;
-  using D = io::TrajectoryReadOptions::Duplicates;
   // The VBR evaluator reads every line, equal stamps included; the others refuse them by default.
-  const std::string dup =
-      o.duplicates.empty() ? (o.convention == "vbr" ? "keep" : "error") : o.duplicates;
-  if (dup == "error")
-    r.duplicates = D::error;
-  else if (dup == "drop")
-    r.duplicates = D::drop;
-  else if (dup == "keep")
-    r.duplicates = D::keep;
-  else
-    throw Error(fmt::format("--duplicate-stamps: expected error, drop or keep, got '{}'", dup));
+  r.duplicates = io::duplicates_from_string(
+      o.duplicates.empty() ? (o.convention == "vbr" ? "keep" : "error") : o.duplicates);
   return r;
 }
 

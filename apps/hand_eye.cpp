@@ -21,6 +21,7 @@ namespace {
 
 struct Options {
   std::string lidar, gnss, sensor = "gnss", lidar_sensor = "lidar", rig, out, report;
+  std::string duplicates = "error";
   std::vector<std::string> fix;  // AXIS=VALUE, GNSS/INS frame
   double spacing_s = 1.0, min_rotation_deg = 1.0, rotation_sigma_deg = 0.05,
          translation_sigma_m = 0.02, max_sigma_m = 0.05;
@@ -68,8 +69,10 @@ void run(const Options& o) {
     T_base_lidar = l->T_base_sensor;
     prior_T_gnss_lidar = g->T_base_sensor.inverse() * T_base_lidar;
   }
-  const Trajectory lidar = io::read_trajectory(o.lidar).trajectory;
-  const Trajectory gnss = io::read_trajectory(o.gnss).trajectory;
+  io::TrajectoryReadOptions read;
+  read.duplicates = io::duplicates_from_string(o.duplicates);
+  const Trajectory lidar = io::read_trajectory(o.lidar, read).trajectory;
+  const Trajectory gnss = io::read_trajectory(o.gnss, read).trajectory;
   if (lidar.size() < 2 || gnss.size() < 2) throw Error("each trajectory needs at least 2 poses");
   std::optional<time_sync::TimeSyncResult> sync;
   if (o.estimate_offset) {
@@ -133,21 +136,29 @@ void run(const Options& o) {
         ob.rotation_singular_values[2], hand_eye::kNearPlanarRatio));
   }
   const hand_eye::Held held = hand_eye::hold_unobservable(ob, prior_T_gnss_lidar, ro.fixed);
+  // Why a direction is not estimated: the motion is near-planar and it is the plane's normal, or
+  // its 1-sigma is too large.
+  auto why = [&](int i) {
+    return ob.near_planar && std::abs(ob.translation_directions.col(i).dot(ob.dominant_axis)) > 0.9
+               ? std::string("near-planar motion, the plane's normal")
+               : fmt::format("1-sigma {:.3f} m above --max-sigma {} m", ob.translation_sigma_m[i],
+                             o.max_sigma_m);
+  };
   for (int i : held.uncovered) {
     const Eigen::Vector3d d = ob.translation_directions.col(i);
     fmt::print(stderr,
                "rigcal: the motion does not determine the translation along [{:.3f} {:.3f} "
-               "{:.3f}] (GNSS/INS frame; 1-sigma {:.3f} m): give --fix (e.g. z=0.35) or a --rig "
-               "whose extrinsic holds it; nothing written\n",
-               d.x(), d.y(), d.z(), ob.translation_sigma_m[i]);
+               "{:.3f}] (GNSS/INS frame; {}): give --fix (e.g. z=0.35) or a --rig whose "
+               "extrinsic holds it; nothing written\n",
+               d.x(), d.y(), d.z(), why(i));
   }
   if (!held.uncovered.empty()) throw Exit{3};
   for (int i : held.from_prior) {
     const Eigen::Vector3d d = ob.translation_directions.col(i);
     notes.push_back(fmt::format(
         "translation along [{:.3f} {:.3f} {:.3f}] (GNSS/INS frame) is not determined by the "
-        "motion (1-sigma {:.3f} m): kept from the rig, {:.4f} m; give --fix to set it",
-        d.x(), d.y(), d.z(), ob.translation_sigma_m[i], d.dot(prior_T_gnss_lidar->t)));
+        "motion ({}): kept from the rig, {:.4f} m; give --fix to set it",
+        d.x(), d.y(), d.z(), why(i), d.dot(prior_T_gnss_lidar->t)));
   }
   const hand_eye::Refined r = hand_eye::refine(pairs, cf.T_gnss_lidar, ro);
   const SE3& X = r.T_gnss_lidar;
@@ -202,6 +213,10 @@ void add_hand_eye(CLI::App& app) {
   cmd->add_option("--lidar", o->lidar, "LiDAR odometry trajectory (T_odom_lidar)")->required();
   cmd->add_option("--gnss", o->gnss, "GNSS/INS trajectory (T_enu_gnss), on its own clock")
       ->required();
+  cmd->add_option("--duplicate-stamps", o->duplicates,
+                  "poses with equal stamps (a 100 Hz Vicon log stamped to 10 ms): error | drop "
+                  "(keep the first) | keep")
+      ->capture_default_str();
   cmd->add_option("--sensor", o->sensor, "the rig's GNSS/INS sensor")->capture_default_str();
   cmd->add_option("--lidar-sensor", o->lidar_sensor, "the rig's LiDAR")->capture_default_str();
   cmd->add_option("--rig", o->rig, "rig: clock offsets, prior extrinsic; updated with --out");

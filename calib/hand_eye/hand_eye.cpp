@@ -89,17 +89,18 @@ Held hold_unobservable(const Observability& ob, const std::optional<SE3>& prior,
   return held;
 }
 
-Refined refine(const std::vector<MotionPair>& pairs, const SE3& initial, const RefineOptions& o) {
-  if (pairs.size() < 3)
-    throw Error(fmt::format("{} motion pairs; at least 3 are needed", pairs.size()));
+namespace {
+
+// One robust solve with the given per-pair sigmas (rad, m), its residuals, outliers and covariance.
+Refined solve(const std::vector<MotionPair>& pairs, const SE3& initial, const RefineOptions& o,
+              double rot_sigma, double trans_sigma) {
   Eigen::Quaterniond q = initial.quaternion();
   Eigen::Vector3d t = initial.t;
-  const double rot_sigma = o.rotation_sigma_deg * M_PI / 180.0;
   ceres::Problem problem;
   for (const MotionPair& p : pairs) {
     problem.AddResidualBlock(
         new ceres::AutoDiffCostFunction<PairError, 6, 4, 3>(new PairError{
-            p.A.quaternion(), p.B.quaternion(), p.A.t, p.B.t, rot_sigma, o.translation_sigma_m}),
+            p.A.quaternion(), p.B.quaternion(), p.A.t, p.B.t, rot_sigma, trans_sigma}),
         new ceres::HuberLoss(o.huber), q.coeffs().data(), t.data());
   }
   for (const RefineOptions::Fixed& f : o.fixed) {
@@ -127,7 +128,7 @@ Refined refine(const std::vector<MotionPair>& pairs, const SE3& initial, const R
     const double rr = rotation_angle(E.R), tr = (p.B.R * X.t + p.B.t - X.R * p.A.t - X.t).norm();
     out.pair_rotation_residual_deg.push_back(rr * 180.0 / M_PI);
     out.pair_translation_residual_m.push_back(tr);
-    z2s.push_back(std::pow(rr / rot_sigma, 2) + std::pow(tr / o.translation_sigma_m, 2));
+    z2s.push_back(std::pow(rr / rot_sigma, 2) + std::pow(tr / trans_sigma, 2));
   }
   std::vector<double> sorted = z2s;
   std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
@@ -164,7 +165,33 @@ Refined refine(const std::vector<MotionPair>& pairs, const SE3& initial, const R
     out.rotation_sigma_deg[i] = std::sqrt(std::max(0.0, out.covariance(i, i))) * 180.0 / M_PI;
     out.translation_sigma_m[i] = std::sqrt(std::max(0.0, out.covariance(3 + i, 3 + i)));
   }
+  out.pair_rotation_noise_deg = rot_sigma * 180.0 / M_PI;
+  out.pair_translation_noise_m = trans_sigma;
   return out;
+}
+
+}  // namespace
+
+Refined refine(const std::vector<MotionPair>& pairs, const SE3& initial, const RefineOptions& o) {
+  if (pairs.size() < 3)
+    throw Error(fmt::format("{} motion pairs; at least 3 are needed", pairs.size()));
+  const Refined first =
+      solve(pairs, initial, o, o.rotation_sigma_deg * M_PI / 180.0, o.translation_sigma_m);
+  // The two noise levels from the inlier residuals (RMS per component: a rotation residual has 3,
+  // a translation residual 3), then solved again with them: a single scale on the given sigmas
+  // would let a noisy rotation inflate the translation's covariance, or the reverse.
+  double rr2 = 0, tr2 = 0;
+  size_t n = 0;
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    if (first.outlier[k]) continue;
+    rr2 += std::pow(first.pair_rotation_residual_deg[k] * M_PI / 180.0, 2);
+    tr2 += std::pow(first.pair_translation_residual_m[k], 2);
+    ++n;
+  }
+  if (n < 3) return first;
+  const double rot_noise = std::sqrt(rr2 / (3.0 * n)), trans_noise = std::sqrt(tr2 / (3.0 * n));
+  if (!(rot_noise > 1e-12 && trans_noise > 1e-12)) return first;
+  return solve(pairs, first.T_gnss_lidar, o, rot_noise, trans_noise);
 }
 
 std::vector<MotionPair> motion_pairs(const Trajectory& lidar, const Trajectory& gnss,

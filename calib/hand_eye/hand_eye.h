@@ -116,6 +116,9 @@ struct Refined {
   std::vector<double> pair_rotation_residual_deg, pair_translation_residual_m;
   std::vector<bool> outlier;  // beyond the 99.9 % of chi-square(6) at the residuals' level
   double noise_scale = 1.0;   // RMS of the normalized residuals: the sigmas' correction factor
+  // The per-pair noise levels the final solve used: estimated from the first solve's inlier
+  // residuals (RMS per component), the given sigmas serving only as a start.
+  double pair_rotation_noise_deg = 0.0, pair_translation_noise_m = 0.0;
 };
 
 // The unobservable directions of `observability` that no entry of `fixed` covers (|cos| > 0.9)
@@ -129,7 +132,8 @@ Held hold_unobservable(const Observability& observability, const std::optional<S
                        std::vector<RefineOptions::Fixed>& fixed);
 
 // Nonlinear least squares over X from `initial` (Ceres, Huber loss): all pairs' rotation and
-// translation residuals together, unlike the closed form's two separate steps.
+// translation residuals together, unlike the closed form's two separate steps. Solved twice: with
+// the given sigmas, then with the rotation and translation noise levels the residuals show.
 Refined refine(const std::vector<MotionPair>& pairs, const SE3& initial,
                const RefineOptions& options = {});
 

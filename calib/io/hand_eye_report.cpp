@@ -60,6 +60,12 @@ std::vector<OutputFile> hand_eye_report_files(const std::filesystem::path& dir,
       {"unobservable_directions", unobs},
       {"max_sigma_m", in.max_sigma_m}};
   j["noise_scale"] = r.noise_scale;
+  j["pair_noise"] = {
+      {"definition",
+       "RMS per component of the inlier pairs' residuals after a first solve with the given "
+       "sigmas; the final solve weighs the pairs with these"},
+      {"rotation_deg", r.pair_rotation_noise_deg},
+      {"translation_m", r.pair_translation_noise_m}};
   j["notes"] = notes;
   nlohmann::json pj = nlohmann::json::array();
   for (size_t k = 0; k < pairs.size(); ++k) {

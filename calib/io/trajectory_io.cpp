@@ -20,6 +20,19 @@ bool is_integer_text(std::string_view s) {
   return true;
 }
 
+// OpenCalib's stamp, "2021-10-26-16-21-29-468": 7 dash-separated integers.
+bool is_dashed_date(std::string_view s) {
+  int dashes = 0;
+  for (char c : s) {
+    if (c == '-') {
+      ++dashes;
+    } else if (c < '0' || c > '9') {
+      return false;
+    }
+  }
+  return dashes == 6 && s.size() == 23;
+}
+
 TrajectoryFormat detect(const std::vector<TextLine>& lines, const std::string& headers,
                         std::string_view file_name) {
   if (headers.find("[ns]") != std::string::npos || headers.find("p_RS_R") != std::string::npos) {
@@ -30,9 +43,11 @@ TrajectoryFormat detect(const std::vector<TextLine>& lines, const std::string& h
   if (csv && fields.size() >= 8 && is_integer_text(fields[0])) return TrajectoryFormat::euroc;
   if (fields.size() == 12) return TrajectoryFormat::kitti;
   if (fields.size() == 8) return TrajectoryFormat::tum;
+  if (fields.size() == 13 && is_dashed_date(fields[0])) return TrajectoryFormat::opencalib;
   fail_at(file_name, lines.front().number, "",
           fmt::format("cannot tell the trajectory format from {} fields (TUM has 8, KITTI 12, "
-                      "EuRoC CSV 8 or more with integer ns stamps); give --format",
+                      "EuRoC CSV 8 or more with integer ns stamps, OpenCalib 13 with a dashed "
+                      "date); give --format",
                       fields.size()));
 }
 
@@ -66,12 +81,21 @@ Eigen::Quaterniond quaternion(std::string_view file, const TextLine& line, doubl
 }  // namespace
 
 TrajectoryFormat trajectory_format_from_string(std::string_view name) {
-  for (TrajectoryFormat f : {TrajectoryFormat::automatic, TrajectoryFormat::tum,
-                             TrajectoryFormat::kitti, TrajectoryFormat::euroc}) {
+  for (TrajectoryFormat f :
+       {TrajectoryFormat::automatic, TrajectoryFormat::tum, TrajectoryFormat::kitti,
+        TrajectoryFormat::euroc, TrajectoryFormat::opencalib}) {
     if (name == to_string(f)) return f;
   }
-  throw Error(
-      fmt::format("unknown trajectory format '{}'; expected auto, tum, kitti or euroc", name));
+  throw Error(fmt::format(
+      "unknown trajectory format '{}'; expected auto, tum, kitti, euroc or opencalib", name));
+}
+
+TrajectoryReadOptions::Duplicates duplicates_from_string(std::string_view name) {
+  using D = TrajectoryReadOptions::Duplicates;
+  if (name == "error") return D::error;
+  if (name == "drop") return D::drop;
+  if (name == "keep") return D::keep;
+  throw Error(fmt::format("--duplicate-stamps: expected error, drop or keep, got '{}'", name));
 }
 
 std::string_view to_string(TrajectoryFormat format) {
@@ -84,6 +108,8 @@ std::string_view to_string(TrajectoryFormat format) {
       return "kitti";
     case TrajectoryFormat::euroc:
       return "euroc";
+    case TrajectoryFormat::opencalib:
+      return "opencalib";
   }
   return "?";
 }
@@ -144,16 +170,22 @@ TrajectoryFile parse_trajectory(std::string_view text, std::string_view file_nam
                                  Eigen::Vector3d(v[1], v[2], v[3]));
         break;
       }
-      case TrajectoryFormat::kitti: {
-        if (f.size() != 12) {
-          fail_at(
-              file_name, line.number, "",
-              fmt::format("expected 12 numbers (KITTI: row-major 3x4 [R | t]), got {}", f.size()));
+      case TrajectoryFormat::kitti:
+      case TrajectoryFormat::opencalib: {
+        const bool oc = out.format == TrajectoryFormat::opencalib;
+        const size_t first = oc ? 1 : 0;
+        if (f.size() != 12 + first) {
+          fail_at(file_name, line.number, "",
+                  oc ? fmt::format("expected a stamp YYYY-MM-DD-HH-MM-SS-mmm and 12 numbers "
+                                   "(OpenCalib: row-major 3x4 [R | t]), got {} fields",
+                                   f.size())
+                     : fmt::format("expected 12 numbers (KITTI: row-major 3x4 [R | t]), got {}",
+                                   f.size()));
         }
         Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
         for (size_t i = 0; i < 12; ++i) {
           m(i / 4, i % 4) =
-              number(file_name, line, f, i, fmt::format("r{}{}", i / 4 + 1, i % 4 + 1));
+              number(file_name, line, f, first + i, fmt::format("r{}{}", i / 4 + 1, i % 4 + 1));
         }
         T = SE3::from_matrix(m);  // kept as read, as the KITTI devkit and evo use it
         const double err = orthonormality_error(T.R);
@@ -162,6 +194,19 @@ TrajectoryFile parse_trajectory(std::string_view text, std::string_view file_nam
                   fmt::format("the 3x3 block is not a rotation (max |R^T R - I| = {:.3g})", err));
         }
         stamp = Time{static_cast<int64_t>(traj.size()) * 1000000000LL};
+        if (oc) {
+          std::string iso(f[0]);
+          if (!is_dashed_date(iso)) {
+            field_error(file_name, line.number, 0, "stamp",
+                        fmt::format("expected YYYY-MM-DD-HH-MM-SS-mmm, got '{}'", f[0]));
+          }
+          iso[10] = 'T', iso[13] = ':', iso[16] = ':', iso[19] = '.';
+          try {
+            stamp = parse_iso8601(iso, "stamp");
+          } catch (const Error& e) {
+            field_error(file_name, line.number, 0, "stamp", e.what());
+          }
+        }
         break;
       }
       case TrajectoryFormat::automatic:

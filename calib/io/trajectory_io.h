@@ -3,6 +3,8 @@
 //   tum    "t tx ty tz qx qy qz qw", seconds; '#' comments; spaces, tabs or commas between fields
 //   kitti  12 numbers a line, the row-major 3x4 [R | t]; stamps from an optional times file
 //   euroc  CSV, "timestamp [ns], px, py, pz, qw, qx, qy, qz, ..." (w first), header lines '#'
+//   opencalib  "YYYY-MM-DD-HH-MM-SS-mmm r11 r12 r13 tx r21 ... tz" (OpenCalib's lidar2imu pose
+//          files: the stamp, read as UTC, then the row-major 3x4 [R | t])
 // Stamps are parsed exactly (calib/core/time.h), never through a double. Every error names the
 // file, the line and the field.
 #include <filesystem>
@@ -13,8 +15,9 @@
 
 namespace rigcal::io {
 
-enum class TrajectoryFormat { automatic, tum, kitti, euroc };
-TrajectoryFormat trajectory_format_from_string(std::string_view name);  // auto|tum|kitti|euroc
+enum class TrajectoryFormat { automatic, tum, kitti, euroc, opencalib };
+// auto|tum|kitti|euroc|opencalib
+TrajectoryFormat trajectory_format_from_string(std::string_view name);
 std::string_view to_string(TrajectoryFormat format);
 
 struct TrajectoryReadOptions {
@@ -26,6 +29,9 @@ struct TrajectoryReadOptions {
   enum class Duplicates { error, drop, keep } duplicates = Duplicates::error;
 };
 
+// "error" | "drop" | "keep"; throws rigcal::Error naming the option otherwise.
+TrajectoryReadOptions::Duplicates duplicates_from_string(std::string_view name);
+
 struct TrajectoryFile {
   Trajectory trajectory;
   TrajectoryFormat format = TrajectoryFormat::tum;  // the format read (after detection)
@@ -33,7 +39,8 @@ struct TrajectoryFile {
 };
 
 // Automatic detection: EuRoC when a header names "[ns]" or "p_RS_R", or when the file ends in
-// .csv and its stamps are integers; else 12 fields make KITTI and 8 make TUM.
+// .csv and its stamps are integers; else 12 fields make KITTI, 8 make TUM, and 13 whose first is a
+// dashed date make OpenCalib.
 TrajectoryFile parse_trajectory(std::string_view text, std::string_view file_name,
                                 const TrajectoryReadOptions& options = {});
 TrajectoryFile read_trajectory(const std::filesystem::path& path,
