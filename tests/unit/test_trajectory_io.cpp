@@ -62,6 +62,21 @@ TEST(TrajectoryIo, KittiWithAndWithoutTimes) {
   std::filesystem::remove(times);
 }
 
+// OpenCalib's lidar2imu pose files: the stamp (UTC, ms) then the row-major 3x4 [R | t].
+TEST(TrajectoryIo, OpenCalibStampsAndMatrices) {
+  const io::TrajectoryFile f = io::parse_trajectory(
+      "2021-10-26-16-21-29-468 1 0 0 0.5 0 1 0 0 0 0 1 0\n"
+      "2021-10-26-16-21-29-568 0 -1 0 1 1 0 0 2 0 0 1 3\n",
+      "p.txt");
+  EXPECT_EQ(f.format, io::TrajectoryFormat::opencalib);
+  ASSERT_EQ(f.trajectory.size(), 2u);
+  EXPECT_EQ(to_iso8601(f.trajectory.stamps[0]), "2021-10-26T16:21:29.468000000");
+  EXPECT_EQ((f.trajectory.stamps[1] - f.trajectory.stamps[0]).ns, 100000000);
+  EXPECT_EQ(f.trajectory.T_world_body[0].t, Eigen::Vector3d(0.5, 0, 0));
+  EXPECT_EQ(f.trajectory.T_world_body[1].t, Eigen::Vector3d(1, 2, 3));
+  EXPECT_EQ(f.trajectory.T_world_body[1].R(1, 0), 1.0);
+}
+
 TEST(TrajectoryIo, EurocIsWFirstWithNanosecondStamps) {
   const std::string text =
       "#timestamp [ns], p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], q_RS_y [], "
@@ -93,7 +108,14 @@ TEST(TrajectoryIo, MalformedFilesNameFileLineAndField) {
   EXPECT_EQ(error_of("1 2 3 4 0 0 0 0\n", "x.txt"), "x.txt:1: zero quaternion");
   EXPECT_EQ(error_of("1 2 3 4 5\n", "x.txt"),
             "x.txt:1: cannot tell the trajectory format from 5 fields (TUM has 8, KITTI 12, EuRoC "
-            "CSV 8 or more with integer ns stamps); give --format");
+            "CSV 8 or more with integer ns stamps, OpenCalib 13 with a dashed date); give "
+            "--format");
+  // OpenCalib: a dashed stamp and 12 numbers; a bad stamp is named.
+  EXPECT_EQ(error_of("2021-10-26-16-21-29-468 1 0 0 0 0 1 0 0 0 0 1 0\n"
+                     "2021-10-26-16-21-29-56x 1 0 0 0 0 1 0 0 0 0 1 0\n",
+                     "o.txt"),
+            "o.txt:2: field 1 (stamp): expected YYYY-MM-DD-HH-MM-SS-mmm, got "
+            "'2021-10-26-16-21-29-56x'");
   EXPECT_EQ(error_of("1s 2 3 4 0 0 0 1\n", "x.txt"),
             "x.txt:1: field 1 (t): expected seconds, got '1s'");
   EXPECT_EQ(error_of("1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0 0 1 0 0 0 0 2 0\n", "k.txt"),
