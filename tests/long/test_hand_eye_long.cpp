@@ -1,6 +1,7 @@
 // Issue 7, acceptance 1 over seeds: the six VBR ground truths replayed (hand-held: colosseo,
 // diag, pincio, spagna; car: campus, ciampino), 10 seeds each; the short version is
 // HandEyeVbrReplay.* in the unit tests. Prints one line per run and a summary per sequence.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -93,6 +94,61 @@ TEST(HandEyeVbrLong, SixSequencesTenSeeds) {
       rot_cover, checked_axes_r, trans_cover, checked_axes_t, runs);
   EXPECT_GE(rot_cover, 0.95 * checked_axes_r);
   EXPECT_GE(trans_cover, 0.95 * checked_axes_t);
+}
+
+// Acceptance 2 on the replays: OpenCV's five methods on the stations of the first 300 pairs
+// (OpenCV forms every two stations: 45,150 motions), rigcal's refinement on the same 300
+// consecutive pairs (the car's vertical held at the truth, so the car compares rotation only)
+// and on OpenCV's own set of motions.
+TEST(HandEyeVbrLong, OpenCvOnTheSameStations) {
+  for (const auto& [seq, car] : std::vector<std::pair<const char*, bool>>{{"colosseo", false},
+                                                                          {"diag", false},
+                                                                          {"pincio", false},
+                                                                          {"spagna", false},
+                                                                          {"campus", true},
+                                                                          {"ciampino", true}}) {
+    RIGCAL_REQUIRE_FIXTURE(path, std::string("trajectories/vbr/") + seq + "_train0_gt.txt");
+    const testing::ReplayRun run = testing::replay_vbr(io::read_trajectory(path).trajectory, 1);
+    std::vector<MotionPair> pairs(run.pairs.begin(),
+                                  run.pairs.begin() + std::min<size_t>(300, run.pairs.size()));
+    auto err = [&](const SE3& X) {
+      return std::make_pair(rotation_angle(X.R * run.truth.R.transpose()) * 180 / M_PI,
+                            1e3 * (X.t - run.truth.t).norm());
+    };
+    RefineOptions ro;
+    const ClosedForm cf = closed_form(pairs);
+    for (int i : cf.observability.unobservable) {
+      const Eigen::Vector3d d = cf.observability.translation_directions.col(i);
+      ro.fixed.push_back({d, d.dot(run.truth.t)});
+    }
+    const auto ours = err(refine(pairs, cf.T_gnss_lidar, ro).T_gnss_lidar);
+    std::vector<MotionPair> every_two;
+    double best_rot = INFINITY, best_trans = INFINITY;
+    std::string line;
+    for (const auto& [method, name] : testing::opencv_methods()) {
+      const auto e =
+          err(testing::opencv_hand_eye(pairs, method, every_two.empty() ? &every_two : nullptr));
+      best_rot = std::min(best_rot, e.first), best_trans = std::min(best_trans, e.second);
+      line += fmt::format(" | {} {:.4f} deg {:.1f} mm", name, e.first, e.second);
+    }
+    const ClosedForm cf_all = closed_form(every_two);
+    RefineOptions ro_all;
+    for (int i : cf_all.observability.unobservable) {
+      const Eigen::Vector3d d = cf_all.observability.translation_directions.col(i);
+      ro_all.fixed.push_back({d, d.dot(run.truth.t)});
+    }
+    const auto ours_all = err(refine(every_two, cf_all.T_gnss_lidar, ro_all).T_gnss_lidar);
+    std::printf(
+        "%-9s (%s) %zu pairs: rigcal %.4f deg %.1f mm%s; rigcal on every two stations %.4f deg "
+        "%.1f mm%s\n",
+        seq, car ? "car" : "hand-held", pairs.size(), ours.first, ours.second,
+        ro.fixed.empty()
+            ? ""
+            : fmt::format(" ({} direction(s) held at the truth)", ro.fixed.size()).c_str(),
+        ours_all.first, ours_all.second, line.c_str());
+    EXPECT_LE(ours.first, best_rot) << seq;
+    if (ro.fixed.empty()) EXPECT_LE(ours.second, best_trans) << seq;
+  }
 }
 
 }  // namespace

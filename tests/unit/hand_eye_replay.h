@@ -4,8 +4,13 @@
 // to a known extrinsic of about 0.3 m and 20 deg, its clock offset (-3.1 ms), odometry noise and
 // RTK noise (2 cm horizontal, 3 cm vertical, outages, multipath jumps). The whole chain runs:
 // clock offset from the trajectories, pairs, closed form, refinement.
+#include <Eigen/Core>
 #include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "rigcal/hand_eye/hand_eye.h"
 #include "rigcal/io/trajectory_io.h"
@@ -21,7 +26,50 @@ struct ReplayRun {
   SE3 truth;  // T_gnss_lidar
   Eigen::Vector3d t_error = Eigen::Vector3d::Zero();
   double rotation_error_deg = 0;
+  std::vector<MotionPair> pairs;
 };
+
+// OpenCV's calibrateHandEye on the stations the pairs chain into (GNSS/INS = gripper, LiDAR =
+// camera, the odometry frame = the target; its X, cam2gripper, is T_gnss_lidar). OpenCV forms a
+// motion from every two stations (i < j), not only consecutive ones: `every_two` receives those
+// motions so rigcal can be run on the same set.
+inline SE3 opencv_hand_eye(const std::vector<MotionPair>& pairs, cv::HandEyeCalibrationMethod m,
+                           std::vector<MotionPair>* every_two = nullptr) {
+  std::vector<cv::Mat> R_g2b, t_g2b, R_t2c, t_t2c;
+  std::vector<SE3> Gs{SE3{}}, Ls{SE3{}};
+  for (const MotionPair& p : pairs) Gs.push_back(Gs.back() * p.B), Ls.push_back(Ls.back() * p.A);
+  for (size_t k = 0; k < Gs.size(); ++k) {
+    cv::Mat R, t, R2, t2;
+    cv::eigen2cv(Gs[k].R, R);
+    cv::eigen2cv(Gs[k].t, t);
+    const SE3 L_inv = Ls[k].inverse();
+    cv::eigen2cv(L_inv.R, R2);
+    cv::eigen2cv(L_inv.t, t2);
+    R_g2b.push_back(R), t_g2b.push_back(t), R_t2c.push_back(R2), t_t2c.push_back(t2);
+  }
+  if (every_two) {
+    for (size_t i = 0; i < Gs.size(); ++i) {
+      for (size_t j = i + 1; j < Gs.size(); ++j)
+        every_two->push_back({Time{}, Time{}, Ls[i].inverse() * Ls[j], Gs[i].inverse() * Gs[j]});
+    }
+  }
+  cv::Mat R, t;
+  cv::calibrateHandEye(R_g2b, t_g2b, R_t2c, t_t2c, R, t, m);
+  SE3 X;
+  cv::cv2eigen(R, X.R);
+  cv::cv2eigen(t, X.t);
+  return X;
+}
+
+inline const std::vector<std::pair<cv::HandEyeCalibrationMethod, const char*>>& opencv_methods() {
+  static const std::vector<std::pair<cv::HandEyeCalibrationMethod, const char*>> m = {
+      {cv::CALIB_HAND_EYE_TSAI, "Tsai"},
+      {cv::CALIB_HAND_EYE_PARK, "Park"},
+      {cv::CALIB_HAND_EYE_HORAUD, "Horaud"},
+      {cv::CALIB_HAND_EYE_ANDREFF, "Andreff"},
+      {cv::CALIB_HAND_EYE_DANIILIDIS, "Daniilidis"}};
+  return m;
+}
 
 // The sequence's ground truth; the unobservable directions (a car's vertical) held at the truth,
 // as `--fix` would with a measured value.
@@ -42,7 +90,8 @@ inline ReplayRun replay_vbr(const Trajectory& gt, uint64_t seed) {
   run.offset_sigma_s = sync.sigma_s;
   PairOptions po;
   po.time_offset_s = sync.offset_s;
-  const std::vector<MotionPair> pairs = motion_pairs(part.odometry, part.gnss, po);
+  run.pairs = motion_pairs(part.odometry, part.gnss, po);
+  const std::vector<MotionPair>& pairs = run.pairs;
   run.closed = closed_form(pairs);
   RefineOptions ro;
   for (int i : run.closed.observability.unobservable) {

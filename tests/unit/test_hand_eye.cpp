@@ -210,53 +210,23 @@ TEST(HandEyeVbrReplay, CarCampus) {
 // ones; rigcal's closed form is run on both sets. Acceptance 2 asks rigcal to be at least as
 // accurate as the best of them; here the closed form alone is compared (no refinement yet).
 void compare_with_opencv(const SimRun& s, const char* what, bool hand_held) {
-  std::vector<cv::Mat> R_g2b, t_g2b, R_t2c, t_t2c;
-  SE3 G, L;
-  auto push = [&] {
-    cv::Mat R, t;
-    cv::eigen2cv(G.R, R);
-    cv::eigen2cv(G.t, t);
-    R_g2b.push_back(R), t_g2b.push_back(t);
-    const SE3 L_inv = L.inverse();  // target (odometry frame) in the camera (LiDAR)
-    cv::Mat R2, t2;
-    cv::eigen2cv(L_inv.R, R2);
-    cv::eigen2cv(L_inv.t, t2);
-    R_t2c.push_back(R2), t_t2c.push_back(t2);
-  };
-  std::vector<SE3> Gs{G}, Ls{L};
-  push();
-  for (const MotionPair& p : s.pairs) {
-    G = G * p.B, L = L * p.A;
-    Gs.push_back(G), Ls.push_back(L);
-    push();
-  }
   std::vector<MotionPair> all;
-  for (size_t i = 0; i < Gs.size(); ++i) {
-    for (size_t j = i + 1; j < Gs.size(); ++j)
-      all.push_back({Time{}, Time{}, Ls[i].inverse() * Ls[j], Gs[i].inverse() * Gs[j]});
-  }
+  std::vector<SE3> opencv;
+  for (const auto& [method, name] : testing::opencv_methods())
+    opencv.push_back(testing::opencv_hand_eye(s.pairs, method, opencv.empty() ? &all : nullptr));
   const ClosedForm ours_all = closed_form(all);
   const double ours_rot = rotation_error_deg(ours_all.T_gnss_lidar, s.truth);
   const double ours_trans = (ours_all.T_gnss_lidar.t - s.truth.t).norm();
   std::printf(
       "%s, %zu stations: rigcal closed form, consecutive pairs %.4f deg, %.2f mm; every two "
       "stations (%zu motions, as OpenCV) %.4f deg, %.2f mm%s\n",
-      what, R_g2b.size(), rotation_error_deg(s.result.T_gnss_lidar, s.truth),
+      what, s.pairs.size() + 1, rotation_error_deg(s.result.T_gnss_lidar, s.truth),
       1e3 * (s.result.T_gnss_lidar.t - s.truth.t).norm(), all.size(), ours_rot, 1e3 * ours_trans,
       ours_all.observability.unobservable.empty() ? "" : " (a direction left unestimated)");
   double best_rot = INFINITY, park_rot = NAN, park_trans = NAN;
-  for (const auto& [method, name] :
-       std::vector<std::pair<cv::HandEyeCalibrationMethod, const char*>>{
-           {cv::CALIB_HAND_EYE_TSAI, "Tsai"},
-           {cv::CALIB_HAND_EYE_PARK, "Park"},
-           {cv::CALIB_HAND_EYE_HORAUD, "Horaud"},
-           {cv::CALIB_HAND_EYE_ANDREFF, "Andreff"},
-           {cv::CALIB_HAND_EYE_DANIILIDIS, "Daniilidis"}}) {
-    cv::Mat R, t;
-    cv::calibrateHandEye(R_g2b, t_g2b, R_t2c, t_t2c, R, t, method);
-    SE3 X;
-    cv::cv2eigen(R, X.R);
-    cv::cv2eigen(t, X.t);
+  for (size_t m = 0; m < opencv.size(); ++m) {
+    const auto& [method, name] = testing::opencv_methods()[m];
+    const SE3& X = opencv[m];
     const double rot = rotation_error_deg(X, s.truth), trans = (X.t - s.truth.t).norm();
     best_rot = std::min(best_rot, rot);
     if (method == cv::CALIB_HAND_EYE_PARK) park_rot = rot, park_trans = trans;
