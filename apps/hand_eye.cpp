@@ -12,6 +12,7 @@
 #include "rigcal/core/se3.h"
 #include "rigcal/core/text.h"
 #include "rigcal/io/files.h"
+#include "rigcal/io/gnss_fixes.h"
 #include "rigcal/io/hand_eye_report.h"
 #include "rigcal/io/trajectory_io.h"
 #include "rigcal/rig/rig_yaml.h"
@@ -21,7 +22,7 @@ namespace {
 
 struct Options {
   std::string lidar, gnss, sensor = "gnss", lidar_sensor = "lidar", rig, out, report;
-  std::string duplicates = "error";
+  std::string duplicates = "error", attitude;
   std::vector<std::string> fix;  // AXIS=VALUE, GNSS/INS frame
   double spacing_s = 1.0, min_rotation_deg = 1.0, rotation_sigma_deg = 0.05,
          translation_sigma_m = 0.02, max_sigma_m = 0.05;
@@ -72,7 +73,31 @@ void run(const Options& o) {
   io::TrajectoryReadOptions read;
   read.duplicates = io::duplicates_from_string(o.duplicates);
   const Trajectory lidar = io::read_trajectory(o.lidar, read).trajectory;
-  const Trajectory gnss = io::read_trajectory(o.gnss, read).trajectory;
+  std::vector<std::string> notes;
+  Trajectory gnss;
+  if (io::is_gnss_fixes_file(o.gnss)) {
+    // Fixes (latitude, longitude, height, attitude) to a local ENU frame at the first fix.
+    if (o.attitude.empty()) {
+      throw Error(fmt::format(
+          "{} holds GNSS fixes: give --attitude enu (yaw counter-clockwise from east) or ned "
+          "(heading clockwise from north, body x forward, z down); see doc/hand-eye.md",
+          o.gnss));
+    }
+    const io::GnssFixes fixes = io::read_gnss_fixes(o.gnss, io::attitude_from_string(o.attitude));
+    gnss = fixes.T_enu_gnss;
+    std::string stds;
+    if (fixes.median_horizontal_std_m)
+      stds += fmt::format("; median std horizontal {:.3f} m", *fixes.median_horizontal_std_m);
+    if (fixes.median_vertical_std_m)
+      stds += fmt::format(", vertical {:.3f} m", *fixes.median_vertical_std_m);
+    notes.push_back(fmt::format(
+        "GNSS fixes converted to ENU (GeographicLib, WGS84) at the first fix: latitude {:.9f}, "
+        "longitude {:.9f}, height {:.3f} m; attitude convention {}{}",
+        fixes.origin.latitude_deg, fixes.origin.longitude_deg, fixes.origin.height_m, o.attitude,
+        stds));
+  } else {
+    gnss = io::read_trajectory(o.gnss, read).trajectory;
+  }
   if (lidar.size() < 2 || gnss.size() < 2) throw Error("each trajectory needs at least 2 poses");
   std::optional<time_sync::TimeSyncResult> sync;
   if (o.estimate_offset) {
@@ -118,7 +143,6 @@ void run(const Options& o) {
   ro.rotation_sigma_deg = o.rotation_sigma_deg;
   ro.translation_sigma_m = o.translation_sigma_m;
   ro.fixed = parse_fixes(o.fix);
-  std::vector<std::string> notes;
   if (sync) {
     notes.push_back(fmt::format(
         "clock offset estimated from the trajectories' angular velocities: t_lidar = t_gnss + "
@@ -211,8 +235,16 @@ void add_hand_eye(CLI::App& app) {
       "with times, EuRoC. Exit 0; 2 on bad input, 3 when a direction is undetermined and\n"
       "nothing fixes it: nothing written in either case.");
   cmd->add_option("--lidar", o->lidar, "LiDAR odometry trajectory (T_odom_lidar)")->required();
-  cmd->add_option("--gnss", o->gnss, "GNSS/INS trajectory (T_enu_gnss), on its own clock")
+  cmd->add_option("--gnss", o->gnss,
+                  "GNSS/INS trajectory (T_enu_gnss; TUM, KITTI, EuRoC, OpenCalib), or a CSV of "
+                  "fixes with a header (time, latitude, longitude, height, roll, pitch, yaw), on "
+                  "its own clock")
       ->required();
+  cmd->add_option("--attitude", o->attitude,
+                  "GNSS fixes CSV only: enu (R = Rz(yaw) Ry(pitch) Rx(roll), yaw from east, "
+                  "counter-clockwise) or ned (heading from north, clockwise; body x forward, z "
+                  "down)")
+      ->check(CLI::IsMember({"enu", "ned"}));
   cmd->add_option("--duplicate-stamps", o->duplicates,
                   "poses with equal stamps (a 100 Hz Vicon log stamped to 10 ms): error | drop "
                   "(keep the first) | keep")

@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <GeographicLib/LocalCartesian.hpp>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -11,6 +12,7 @@
 #include <sstream>
 
 #include "fixtures.h"
+#include "rigcal/io/trajectory_io.h"
 
 namespace {
 
@@ -499,6 +501,62 @@ TEST_F(Cli, HandEyeEthMotionCapture) {
       j["inputs"]["gnss_time_offset_s"].get<double>());
   EXPECT_LT(res_rot[m], 0.2 * rot[m]);
   EXPECT_TRUE(j["observability"]["unobservable_directions"].empty());
+}
+
+// GNSS fixes as CSV: the simulated GNSS/INS poses written as latitude, longitude, height and NED
+// roll, pitch, heading (GeographicLib's reverse, origin in Rome), read back to ENU: the same
+// extrinsic as from the TUM poses (the hand-eye does not depend on the world frame).
+TEST_F(Cli, HandEyeReadsGnssFixes) {
+  const fs::path sim = dir_ / "sim";
+  ASSERT_EQ(run("simulate --what trajectories --out " + sim.string()).status, 0);
+  const rigcal::Trajectory gnss =
+      rigcal::io::read_trajectory(sim / "trajectories" / "gnss_ins.tum").trajectory;
+  GeographicLib::LocalCartesian enu(41.9, 12.5, 50.0);
+  const Eigen::Matrix3d R_enu_ned = (Eigen::Matrix3d() << 0, 1, 0, 1, 0, 0, 0, 0, -1).finished();
+  std::string csv =
+      "# simulated\ntime,latitude,longitude,height,roll,pitch,yaw,std_east,std_north,std_up\n";
+  for (size_t k = 0; k < gnss.size(); ++k) {
+    const rigcal::SE3& T = gnss.T_world_body[k];
+    double lat, lon, h;
+    enu.Reverse(T.t.x(), T.t.y(), T.t.z(), lat, lon, h);
+    const Eigen::Matrix3d R = R_enu_ned.transpose() * T.R;  // R_ned_body
+    const double yaw = std::atan2(R(1, 0), R(0, 0)), pitch = -std::asin(R(2, 0)),
+                 roll = std::atan2(R(2, 1), R(2, 2));
+    csv += fmt::format("{},{:.12f},{:.12f},{:.6f},{:.9f},{:.9f},{:.9f},0.02,0.02,0.03\n",
+                       rigcal::to_seconds_text(gnss.stamps[k]), lat, lon, h, roll * 180 / M_PI,
+                       pitch * 180 / M_PI, yaw * 180 / M_PI);
+  }
+  const fs::path fixes = write("fixes.csv", csv);
+  const std::string lidar = " --lidar " + (sim / "trajectories" / "lidar_odometry.tum").string();
+  CliRun r = run("hand-eye" + lidar + " --gnss " + fixes.string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("give --attitude"), std::string::npos) << r.err;
+  const std::string rep_f = (dir_ / "rep_f").string(), rep_t = (dir_ / "rep_t").string();
+  r = run("hand-eye" + lidar + " --gnss " + fixes.string() + " --attitude ned --report " + rep_f);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("GNSS fixes converted to ENU"), std::string::npos) << r.out;
+  r = run("hand-eye" + lidar + " --gnss " + (sim / "trajectories" / "gnss_ins.tum").string() +
+          " --report " + rep_t);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json jf = nlohmann::json::parse(slurp(fs::path(rep_f) / "hand_eye.json"));
+  const nlohmann::json jt = nlohmann::json::parse(slurp(fs::path(rep_t) / "hand_eye.json"));
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(jf["T_gnss_lidar"]["t_m"][i].get<double>(),
+                jt["T_gnss_lidar"]["t_m"][i].get<double>(), 1e-4);
+    EXPECT_NEAR(jf["T_gnss_lidar"]["roll_pitch_yaw_deg"][i].get<double>(),
+                jt["T_gnss_lidar"]["roll_pitch_yaw_deg"][i].get<double>(), 1e-4);
+  }
+  // A missing column and a latitude out of range are named with file and line.
+  const fs::path bad = write("bad.csv", "time,latitude,longitude,height,roll,pitch\n0,1,2,3,4,5\n");
+  r = run("hand-eye" + lidar + " --gnss " + bad.string() + " --attitude enu");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("bad.csv:1: the header has no 'yaw' column"), std::string::npos) << r.err;
+  const fs::path bad2 =
+      write("bad2.csv",
+            "time,lat,lon,alt,roll,pitch,heading\n0,41.9,12.5,3,0,0,0\n1,141.9,12.5,3,0,0,0\n");
+  r = run("hand-eye" + lidar + " --gnss " + bad2.string() + " --attitude enu");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("bad2.csv:3: latitude 141.9"), std::string::npos) << r.err;
 }
 
 TEST_F(Cli, HandEyeWritesTheExtrinsicAndRefusesAnUndeterminedDirection) {

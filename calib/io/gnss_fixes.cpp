@@ -1,0 +1,180 @@
+#include "rigcal/io/gnss_fixes.h"
+
+#include <fmt/format.h>
+
+#include <Eigen/Geometry>
+#include <GeographicLib/LocalCartesian.hpp>
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <fstream>
+
+#include "rigcal/core/error.h"
+#include "rigcal/core/text.h"
+#include "rigcal/core/time.h"
+#include "rigcal/io/files.h"
+
+namespace rigcal::io {
+namespace {
+
+std::string lower(std::string_view s) {
+  std::string out(trim(s));
+  for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
+double median(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+Eigen::Matrix3d rpy(double roll, double pitch, double yaw) {
+  return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
+// The header's column index of each name (first of its aliases), -1 when absent.
+enum Column { kTime, kLat, kLon, kHeight, kRoll, kPitch, kYaw, kStdE, kStdN, kStdU, kColumns };
+const std::array<std::vector<std::string_view>, kColumns> kAliases = {{
+    {"time", "t", "timestamp", "stamp"},
+    {"latitude", "lat"},
+    {"longitude", "lon", "lng"},
+    {"height", "alt", "altitude", "h"},
+    {"roll"},
+    {"pitch"},
+    {"yaw", "heading", "azimuth"},
+    {"std_east", "sigma_east"},
+    {"std_north", "sigma_north"},
+    {"std_up", "sigma_up"},
+}};
+
+}  // namespace
+
+Attitude attitude_from_string(std::string_view name) {
+  if (name == "enu") return Attitude::enu;
+  if (name == "ned") return Attitude::ned;
+  throw Error(fmt::format("--attitude: expected enu or ned, got '{}'", name));
+}
+
+bool is_gnss_fixes_file(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    const std::string_view t = trim(line);
+    if (t.empty() || t.front() == '#') continue;
+    for (std::string_view f : split_fields(t)) {
+      const std::string name = lower(f);
+      if (name == "latitude" || name == "lat") return true;
+    }
+    return false;
+  }
+  return false;
+}
+
+GnssFixes parse_gnss_fixes(std::string_view text, std::string_view file_name, Attitude attitude,
+                           const std::optional<GeodeticOrigin>& origin) {
+  // The header: the first non-empty, non-comment line.
+  std::array<int, kColumns> col;
+  col.fill(-1);
+  size_t pos = 0;
+  int line_no = 0, header_line = 0;
+  std::vector<std::pair<int, std::string_view>> rows;
+  while (pos <= text.size()) {
+    const size_t end = std::min(text.find('\n', pos), text.size());
+    const std::string_view line = trim(text.substr(pos, end - pos));
+    ++line_no;
+    pos = end + 1;
+    if (line.empty() || line.front() == '#') continue;
+    if (header_line == 0) {
+      header_line = line_no;
+      const std::vector<std::string_view> names = split_fields(line);
+      for (size_t i = 0; i < names.size(); ++i) {
+        const std::string name = lower(names[i]);
+        for (int c = 0; c < kColumns; ++c) {
+          if (col[c] < 0 &&
+              std::find(kAliases[c].begin(), kAliases[c].end(), name) != kAliases[c].end())
+            col[c] = static_cast<int>(i);
+        }
+      }
+      for (int c = 0; c <= kYaw; ++c) {
+        if (col[c] < 0) {
+          fail_at(file_name, line_no, "",
+                  fmt::format("the header has no '{}' column (GNSS fixes need time, latitude, "
+                              "longitude, height, roll, pitch, yaw)",
+                              kAliases[c].front()));
+        }
+      }
+      continue;
+    }
+    rows.emplace_back(line_no, line);
+  }
+  if (rows.empty()) fail_at(file_name, header_line, "", "no fixes after the header");
+
+  GnssFixes out;
+  GeographicLib::LocalCartesian enu;
+  std::vector<double> std_h, std_v;
+  const Eigen::Matrix3d R_enu_ned = (Eigen::Matrix3d() << 0, 1, 0, 1, 0, 0, 0, 0, -1).finished();
+  const double deg = M_PI / 180.0;
+  for (const auto& [number, line] : rows) {
+    const std::vector<std::string_view> f = split_fields(line);
+    auto value = [&](Column c) {
+      const int i = col[c];
+      if (i >= static_cast<int>(f.size())) {
+        fail_at(
+            file_name, number, "",
+            fmt::format("{} fields, no '{}' (column {})", f.size(), kAliases[c].front(), i + 1));
+      }
+      try {
+        return parse_double(f[i], kAliases[c].front());
+      } catch (const Error&) {
+        fail_at(file_name, number, "",
+                fmt::format("column {} ({}): expected a number, got '{}'", i + 1,
+                            kAliases[c].front(), f[i]));
+      }
+    };
+    if (col[kTime] >= static_cast<int>(f.size())) {
+      fail_at(file_name, number, "", fmt::format("{} fields, no time", f.size()));
+    }
+    Time stamp;
+    try {
+      stamp = parse_time(f[col[kTime]], "time");
+    } catch (const Error& e) {
+      fail_at(file_name, number, "", fmt::format("column {} (time): {}", col[kTime] + 1, e.what()));
+    }
+    const double lat = value(kLat), lon = value(kLon), h = value(kHeight);
+    if (std::abs(lat) > 90 || std::abs(lon) > 360) {
+      fail_at(file_name, number, "",
+              fmt::format("latitude {} / longitude {} out of range (degrees expected)", lat, lon));
+    }
+    if (out.T_enu_gnss.stamps.empty()) {
+      out.origin = origin.value_or(GeodeticOrigin{lat, lon, h});
+      enu.Reset(out.origin.latitude_deg, out.origin.longitude_deg, out.origin.height_m);
+    }
+    if (!out.T_enu_gnss.stamps.empty() && stamp <= out.T_enu_gnss.stamps.back()) {
+      fail_at(file_name, number, "",
+              fmt::format("time {} does not increase (previous {} s)", f[col[kTime]],
+                          to_seconds_text(out.T_enu_gnss.stamps.back())));
+    }
+    SE3 T;
+    enu.Forward(lat, lon, h, T.t.x(), T.t.y(), T.t.z());
+    const double roll = value(kRoll) * deg, pitch = value(kPitch) * deg, yaw = value(kYaw) * deg;
+    T.R = attitude == Attitude::enu ? rpy(roll, pitch, yaw) : R_enu_ned * rpy(roll, pitch, yaw);
+    out.T_enu_gnss.stamps.push_back(stamp);
+    out.T_enu_gnss.T_world_body.push_back(T);
+    if (col[kStdE] >= 0 && col[kStdN] >= 0) std_h.push_back(std::hypot(value(kStdE), value(kStdN)));
+    if (col[kStdU] >= 0) std_v.push_back(value(kStdU));
+  }
+  if (!std_h.empty()) out.median_horizontal_std_m = median(std_h);
+  if (!std_v.empty()) out.median_vertical_std_m = median(std_v);
+  return out;
+}
+
+GnssFixes read_gnss_fixes(const std::filesystem::path& path, Attitude attitude,
+                          const std::optional<GeodeticOrigin>& origin) {
+  return parse_gnss_fixes(read_text_file(path), path.string(), attitude, origin);
+}
+
+}  // namespace rigcal::io

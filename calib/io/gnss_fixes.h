@@ -1,0 +1,47 @@
+#pragma once
+// GNSS/INS fixes as CSV (doc/hand-eye.md, "GNSS fixes"): a header line naming the columns, then
+// one fix a line. Required columns (any order, case-insensitive): time (or t, timestamp: seconds
+// or ISO-8601 UTC), latitude (lat), longitude (lon), height (alt, altitude: ellipsoidal, m), roll,
+// pitch, yaw (or heading), in degrees. Optional: the standard deviations std_east, std_north,
+// std_up (m). Converted with GeographicLib to a local ENU frame at the first fix (or a given
+// origin): T_enu_gnss, the body frame being the one the attitude convention defines.
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "rigcal/core/trajectory.h"
+
+namespace rigcal::io {
+
+enum class Attitude {
+  // R_enu_body = Rz(yaw) Ry(pitch) Rx(roll); yaw counter-clockwise from east; the body frame is
+  // whatever the INS reports attitude for (typically x right, y forward, z up in ENU-style INS).
+  enu,
+  // The aviation / NovAtel-SBG convention: heading clockwise from north, body x forward, y right,
+  // z down: R_ned_body = Rz(yaw) Ry(pitch) Rx(roll), then R_enu_ned.
+  ned,
+};
+Attitude attitude_from_string(std::string_view name);  // enu | ned
+
+struct GeodeticOrigin {
+  double latitude_deg = 0, longitude_deg = 0, height_m = 0;
+};
+
+struct GnssFixes {
+  Trajectory T_enu_gnss;
+  GeodeticOrigin origin;                                                 // of the ENU frame
+  std::optional<double> median_horizontal_std_m, median_vertical_std_m;  // when given
+};
+
+// True when the file's first non-comment line is a header naming a latitude column.
+bool is_gnss_fixes_file(const std::filesystem::path& path);
+
+// Throws rigcal::Error naming file, line and column on a missing column, a bad number, a
+// latitude outside [-90, 90], stamps that do not increase.
+GnssFixes parse_gnss_fixes(std::string_view text, std::string_view file_name, Attitude attitude,
+                           const std::optional<GeodeticOrigin>& origin = std::nullopt);
+GnssFixes read_gnss_fixes(const std::filesystem::path& path, Attitude attitude,
+                          const std::optional<GeodeticOrigin>& origin = std::nullopt);
+
+}  // namespace rigcal::io
