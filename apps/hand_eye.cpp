@@ -24,7 +24,7 @@ struct Options {
   std::string lidar, gnss, sensor = "gnss", lidar_sensor = "lidar", rig, out, report;
   std::string duplicates = "error", attitude;
   std::vector<std::string> fix;  // AXIS=VALUE, GNSS/INS frame
-  double spacing_s = 1.0, min_rotation_deg = 1.0, rotation_sigma_deg = 0.05,
+  double spacing_s = 1.0, stride_s = 0.1, min_rotation_deg = 1.0, rotation_sigma_deg = 0.05,
          translation_sigma_m = 0.02, max_sigma_m = 0.05;
   bool estimate_offset = false;
 };
@@ -125,6 +125,7 @@ void run(const Options& o) {
   }
   hand_eye::PairOptions po;
   po.spacing_s = o.spacing_s;
+  po.stride_s = o.stride_s;
   po.min_rotation_deg = o.min_rotation_deg;
   po.time_offset_s = offset_s;
   const std::vector<hand_eye::MotionPair> pairs = hand_eye::motion_pairs(lidar, gnss, po);
@@ -191,8 +192,9 @@ void run(const Options& o) {
   size_t outliers = 0;
   for (bool b : r.outlier) outliers += b;
 
-  fmt::print("{} motion pairs of {} s (LiDAR {} poses, GNSS/INS {} poses)\n", pairs.size(),
-             o.spacing_s, lidar.size(), gnss.size());
+  fmt::print("{} motion pairs of {} s every {} s (LiDAR {} poses, GNSS/INS {} poses)\n",
+             pairs.size(), o.spacing_s, o.stride_s > 0 ? o.stride_s : o.spacing_s, lidar.size(),
+             gnss.size());
   fmt::print(
       "observability: rotation singular values {:.3f} {:.3f} {:.3f} rad; translation 1-sigma along "
       "its principal directions {:.4f} {:.4f} {:.4f} m\n",
@@ -204,12 +206,15 @@ void run(const Options& o) {
       "{:.3f} {:.3f} {:.3f} ± {:.3f} {:.3f} {:.3f} deg; {} outlier pairs\n",
       o.sensor, o.lidar_sensor, X.t.x(), X.t.y(), X.t.z(), sig_t.x(), sig_t.y(), sig_t.z(), rpy.x(),
       rpy.y(), rpy.z(), sig_r.x(), sig_r.y(), sig_r.z(), outliers);
+  fmt::print("odometry scale {:.5f} ± {:.5f} (GNSS/INS distance over LiDAR distance)\n",
+             r.odometry_scale, r.odometry_scale_sigma);
   for (const std::string& n : notes) fmt::print("note: {}\n", n);
 
   std::vector<io::OutputFile> files;
   if (!o.report.empty()) {
-    io::HandEyeInputs in{o.lidar,       o.gnss, o.rig, offset_s, o.spacing_s, o.min_rotation_deg,
-                         o.max_sigma_m, notes};
+    io::HandEyeInputs in{
+        o.lidar,       o.gnss, o.rig, offset_s, o.spacing_s, o.stride_s, o.min_rotation_deg,
+        o.max_sigma_m, notes};
     files = io::hand_eye_report_files(o.report, in, pairs, cf, r, lidar, gnss);
   }
   if (!o.out.empty()) {
@@ -261,6 +266,10 @@ void add_hand_eye(CLI::App& app) {
                 "estimate the clock offset from the trajectories' angular velocities (around "
                 "the rig's value, +-1 s) and write it as the sensor's time_offset");
   cmd->add_option("--spacing", o->spacing_s, "seconds between a pair's two poses")
+      ->capture_default_str();
+  cmd->add_option("--stride", o->stride_s,
+                  "seconds between the starts of consecutive pairs (0: end to end); overlapping "
+                  "pairs are not counted as independent in the covariance")
       ->capture_default_str();
   cmd->add_option("--min-rotation", o->min_rotation_deg, "pairs rotating less are dropped (deg)")
       ->capture_default_str();

@@ -28,21 +28,22 @@ std::optional<SE3> pose_at(const Trajectory& traj, Time t, Time max_gap) {
                             (t - a).seconds() / (b - a).seconds());
 }
 
-// One pair: rotation 2 vec(q_B^-1 q_X q_A q_X^-1) and translation R_B t_X + t_B - R_X t_A - t_X,
-// each over its sigma.
+// One pair: rotation 2 vec(q_B^-1 q_X q_A q_X^-1) and translation R_B t_X + t_B - R_X s t_A - t_X
+// (s: the odometry's scale correction), each over its sigma.
 struct PairError {
   Eigen::Quaterniond q_A, q_B;
   Eigen::Vector3d t_A, t_B;
   double rot_sigma, trans_sigma;
   template <typename T>
-  bool operator()(const T* q_x, const T* t_x, T* r) const {
+  bool operator()(const T* q_x, const T* t_x, const T* scale, T* r) const {
     const Eigen::Map<const Eigen::Quaternion<T>> qX(q_x);
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> tX(t_x);
     const Eigen::Quaternion<T> qA = q_A.cast<T>(), qB = q_B.cast<T>();
     const Eigen::Quaternion<T> e = qB.conjugate() * qX * qA * qX.conjugate();
     const T sign = e.w() < T(0) ? T(-1) : T(1);
     for (int i = 0; i < 3; ++i) r[i] = sign * T(2) * e.vec()[i] / T(rot_sigma);
-    const Eigen::Matrix<T, 3, 1> et = qB * tX + t_B.cast<T>() - qX * t_A.cast<T>() - tX;
+    const Eigen::Matrix<T, 3, 1> et =
+        qB * tX + t_B.cast<T>() - qX * (scale[0] * t_A.cast<T>()) - tX;
     for (int i = 0; i < 3; ++i) r[3 + i] = et[i] / T(trans_sigma);
     return true;
   }
@@ -91,17 +92,102 @@ Held hold_unobservable(const Observability& ob, const std::optional<SE3>& prior,
 
 namespace {
 
+// The window L of the Bartlett weights over the pairs `in` (indices, in time order): twice the
+// largest number of following pairs that start before or when a pair ends (pairs end to end
+// share a fix: 1; pairs every 0.1 s of 1 s: 10), at most kMaxLag (motions between every two
+// stations of a long trajectory all overlap; their covariance is not meaningful anyway).
+size_t bartlett_window(const std::vector<MotionPair>& pairs, const std::vector<size_t>& in) {
+  constexpr size_t kMaxLag = 128;
+  size_t max_lag = 1;
+  for (size_t n = 0; n < in.size() && max_lag < kMaxLag; ++n) {
+    size_t lag = 0;
+    for (size_t m = n + 1; m < in.size() && lag < kMaxLag && pairs[in[m]].t0 <= pairs[in[n]].t1;
+         ++m)
+      ++lag;
+    max_lag = std::max(max_lag, lag);
+  }
+  return 2 * max_lag;
+}
+
+// The covariance of X's 6 parameters (rotation as a left perturbation, rad; then translation, m)
+// by the sandwich H^-1 S H^-1 over the inlier pairs (normalized residuals r_k, Jacobians J_k by
+// central differences): H = sum J_k^T J_k (plus the held directions), S = sum over pairs k, j
+// whose time intervals touch or overlap (they share GNSS/INS fixes or odometry steps, so their
+// errors are correlated) of w_kj J_k^T r_k r_j^T J_j, Bartlett weights w = 1 - lag / (L + 1)
+// with L twice the largest such lag (Newey and West's estimator, generous in the window). With
+// independent pairs it is the usual covariance scaled by the residuals' level; with correlated
+// ones it does not count the same noise twice.
+Eigen::Matrix<double, 7, 7> sandwich_covariance(const std::vector<MotionPair>& pairs, const SE3& X,
+                                                double scale, const std::vector<bool>& outlier,
+                                                const RefineOptions& o, double rot_sigma,
+                                                double trans_sigma) {
+  using Vec6 = Eigen::Matrix<double, 6, 1>;
+  using Vec7 = Eigen::Matrix<double, 7, 1>;
+  using Mat67 = Eigen::Matrix<double, 6, 7>;
+  using Mat7 = Eigen::Matrix<double, 7, 7>;
+  auto residual = [&](const MotionPair& p, const Vec7& d) {
+    const SE3 Xd{rotation_from_vector(d.head<3>()) * X.R, X.t + d.segment<3>(3)};
+    const double sd = scale + d[6];
+    const PairError e{p.A.quaternion(), p.B.quaternion(), p.A.t, p.B.t, rot_sigma, trans_sigma};
+    const Eigen::Quaterniond q = Xd.quaternion();
+    Vec6 r;
+    e(q.coeffs().data(), Xd.t.data(), &sd, r.data());
+    return r;
+  };
+  std::vector<size_t> in;
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    if (!outlier[k]) in.push_back(k);
+  }
+  std::vector<Vec6> r(in.size());
+  std::vector<Mat67> J(in.size());
+  Mat7 H = Mat7::Zero();
+  const double h = 1e-6;
+  for (size_t n = 0; n < in.size(); ++n) {
+    const MotionPair& p = pairs[in[n]];
+    r[n] = residual(p, Vec7::Zero());
+    for (int c = 0; c < 7; ++c) {
+      Vec7 d = Vec7::Zero();
+      d[c] = h;
+      J[n].col(c) = (residual(p, d) - residual(p, -d)) / (2 * h);
+    }
+    H += J[n].transpose() * J[n];
+  }
+  const size_t L = bartlett_window(pairs, in);
+  Mat7 S = Mat7::Zero();
+  for (size_t n = 0; n < in.size(); ++n) {
+    const Vec7 g = J[n].transpose() * r[n];
+    S += g * g.transpose();
+    for (size_t m = n + 1; m < in.size() && m <= n + L; ++m) {
+      const double w = 1.0 - static_cast<double>(m - n) / (L + 1);
+      const Vec7 gm = J[m].transpose() * r[m];
+      S += w * (g * gm.transpose() + gm * g.transpose());
+    }
+  }
+  // Held translation components and, when not estimated, the scale: stiff priors.
+  for (const RefineOptions::Fixed& f : o.fixed) {
+    Vec7 a = Vec7::Zero();
+    a.segment<3>(3) = f.direction.normalized() / 1e-6;
+    H += a * a.transpose();
+  }
+  if (!o.estimate_scale) H(6, 6) += 1e18;
+  const Mat7 Hinv = H.inverse();
+  const double dof_correction =
+      in.size() > 6 ? static_cast<double>(in.size()) / static_cast<double>(in.size() - 6) : 1.0;
+  return dof_correction * Hinv * S * Hinv;
+}
+
 // One robust solve with the given per-pair sigmas (rad, m), its residuals, outliers and covariance.
-Refined solve(const std::vector<MotionPair>& pairs, const SE3& initial, const RefineOptions& o,
-              double rot_sigma, double trans_sigma) {
+Refined solve(const std::vector<MotionPair>& pairs, const SE3& initial, double initial_scale,
+              const RefineOptions& o, double rot_sigma, double trans_sigma) {
   Eigen::Quaterniond q = initial.quaternion();
   Eigen::Vector3d t = initial.t;
+  double scale = initial_scale;
   ceres::Problem problem;
   for (const MotionPair& p : pairs) {
     problem.AddResidualBlock(
-        new ceres::AutoDiffCostFunction<PairError, 6, 4, 3>(new PairError{
+        new ceres::AutoDiffCostFunction<PairError, 6, 4, 3, 1>(new PairError{
             p.A.quaternion(), p.B.quaternion(), p.A.t, p.B.t, rot_sigma, trans_sigma}),
-        new ceres::HuberLoss(o.huber), q.coeffs().data(), t.data());
+        new ceres::HuberLoss(o.huber), q.coeffs().data(), t.data(), &scale);
   }
   for (const RefineOptions::Fixed& f : o.fixed) {
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<FixedError, 1, 3>(
@@ -109,6 +195,7 @@ Refined solve(const std::vector<MotionPair>& pairs, const SE3& initial, const Re
                              nullptr, t.data());
   }
   problem.SetManifold(q.coeffs().data(), new ceres::EigenQuaternionManifold);
+  if (!o.estimate_scale) problem.SetParameterBlockConstant(&scale);
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_QR;
   so.max_num_iterations = 100;
@@ -118,14 +205,15 @@ Refined solve(const std::vector<MotionPair>& pairs, const SE3& initial, const Re
 
   Refined out;
   out.T_gnss_lidar = SE3::from_quaternion(q, t);
+  out.odometry_scale = scale;
   const SE3& X = out.T_gnss_lidar;
   // Outliers: a pair's squared normalized residual (6 components) beyond the 99.9 % point of
   // chi-square with 6 dof (22.46), after scaling the sigmas by the residuals' own level (the
   // median of chi-square(6) is 5.35), so that sigmas set too small do not flag every pair.
   std::vector<double> z2s;
   for (const MotionPair& p : pairs) {
-    const SE3 E = (X * p.A).inverse() * (p.B * X);
-    const double rr = rotation_angle(E.R), tr = (p.B.R * X.t + p.B.t - X.R * p.A.t - X.t).norm();
+    const double rr = rotation_angle((X.R * p.A.R).transpose() * (p.B.R * X.R));
+    const double tr = (p.B.R * X.t + p.B.t - X.R * (scale * p.A.t) - X.t).norm();
     out.pair_rotation_residual_deg.push_back(rr * 180.0 / M_PI);
     out.pair_translation_residual_m.push_back(tr);
     z2s.push_back(std::pow(rr / rot_sigma, 2) + std::pow(tr / trans_sigma, 2));
@@ -143,24 +231,10 @@ Refined solve(const std::vector<MotionPair>& pairs, const SE3& initial, const Re
   const double dof =
       std::max(1.0, 6.0 * static_cast<double>(n_in) - 6.0 + static_cast<double>(o.fixed.size()));
   out.noise_scale = std::sqrt(ss / dof);
-  ceres::Covariance::Options co;
-  co.algorithm_type = ceres::DENSE_SVD;
-  co.null_space_rank = -1;
-  ceres::Covariance cov(co);
-  std::vector<std::pair<const double*, const double*>> blocks = {
-      {q.coeffs().data(), q.coeffs().data()}, {q.coeffs().data(), t.data()}, {t.data(), t.data()}};
-  if (cov.Compute(blocks, &problem)) {
-    Eigen::Matrix<double, 3, 3, Eigen::RowMajor> qq, qt, tt;
-    cov.GetCovarianceBlockInTangentSpace(q.coeffs().data(), q.coeffs().data(), qq.data());
-    cov.GetCovarianceBlockInTangentSpace(q.coeffs().data(), t.data(), qt.data());
-    cov.GetCovarianceBlock(t.data(), t.data(), tt.data());
-    // Ceres' quaternion tangent d rotates by 2|d|: rotation covariance is 4 times.
-    out.covariance.block<3, 3>(0, 0) = 4.0 * qq;
-    out.covariance.block<3, 3>(0, 3) = 2.0 * qt;
-    out.covariance.block<3, 3>(3, 0) = 2.0 * qt.transpose();
-    out.covariance.block<3, 3>(3, 3) = tt;
-    out.covariance *= out.noise_scale * out.noise_scale;
-  }
+  const Eigen::Matrix<double, 7, 7> C =
+      sandwich_covariance(pairs, X, scale, out.outlier, o, rot_sigma, trans_sigma);
+  out.covariance = C.topLeftCorner<6, 6>();
+  out.odometry_scale_sigma = o.estimate_scale ? std::sqrt(std::max(0.0, C(6, 6))) : 0.0;
   for (int i = 0; i < 3; ++i) {
     out.rotation_sigma_deg[i] = std::sqrt(std::max(0.0, out.covariance(i, i))) * 180.0 / M_PI;
     out.translation_sigma_m[i] = std::sqrt(std::max(0.0, out.covariance(3 + i, 3 + i)));
@@ -176,7 +250,7 @@ Refined refine(const std::vector<MotionPair>& pairs, const SE3& initial, const R
   if (pairs.size() < 3)
     throw Error(fmt::format("{} motion pairs; at least 3 are needed", pairs.size()));
   const Refined first =
-      solve(pairs, initial, o, o.rotation_sigma_deg * M_PI / 180.0, o.translation_sigma_m);
+      solve(pairs, initial, 1.0, o, o.rotation_sigma_deg * M_PI / 180.0, o.translation_sigma_m);
   // The two noise levels from the inlier residuals (RMS per component: a rotation residual has 3,
   // a translation residual 3), then solved again with them: a single scale on the given sigmas
   // would let a noisy rotation inflate the translation's covariance, or the reverse.
@@ -191,7 +265,7 @@ Refined refine(const std::vector<MotionPair>& pairs, const SE3& initial, const R
   if (n < 3) return first;
   const double rot_noise = std::sqrt(rr2 / (3.0 * n)), trans_noise = std::sqrt(tr2 / (3.0 * n));
   if (!(rot_noise > 1e-12 && trans_noise > 1e-12)) return first;
-  return solve(pairs, first.T_gnss_lidar, o, rot_noise, trans_noise);
+  return solve(pairs, first.T_gnss_lidar, first.odometry_scale, o, rot_noise, trans_noise);
 }
 
 std::vector<MotionPair> motion_pairs(const Trajectory& lidar, const Trajectory& gnss,
@@ -267,8 +341,26 @@ ClosedForm closed_form(const std::vector<MotionPair>& pairs, double max_sigma_m)
   out.observability.translation_singular_values = sv;
   out.observability.translation_directions = ts.matrixV();
   const Eigen::Vector3d t_full = ts.solve(y);
-  const double dof = std::max(1.0, static_cast<double>(y.size()) - 3.0);
-  const double sigma_r = std::sqrt((M * t_full - y).squaredNorm() / dof);
+  // The 1-sigma along each right singular vector v_i: sqrt(v_i^T S v_i) / s_i^2, S the Bartlett
+  // sum of the pairs' M_k^T e_k e_j^T M_j (e = residuals), as in the refinement: pairs sharing a
+  // fix or overlapping are not counted as independent.
+  std::vector<size_t> all(pairs.size());
+  for (size_t k = 0; k < pairs.size(); ++k) all[k] = k;
+  const size_t L = bartlett_window(pairs, all);
+  std::vector<Eigen::Vector3d> g(pairs.size());
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    const Eigen::Matrix3d Mk = M.block<3, 3>(3 * k, 0);
+    g[k] = Mk.transpose() * (Mk * t_full - y.segment<3>(3 * k));
+  }
+  Eigen::Matrix3d Sg = Eigen::Matrix3d::Zero();
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    Sg += g[k] * g[k].transpose();
+    for (size_t m = k + 1; m < pairs.size() && m <= k + L; ++m) {
+      const double w = 1.0 - static_cast<double>(m - k) / (L + 1);
+      Sg += w * (g[k] * g[m].transpose() + g[m] * g[k].transpose());
+    }
+  }
+  Sg *= static_cast<double>(pairs.size()) / std::max<double>(1.0, pairs.size() - 1.0);
   Eigen::Vector3d t = Eigen::Vector3d::Zero();
   const Eigen::VectorXd Uty = ts.matrixU().transpose() * y;
   // Near-planar motion: the direction closest to the dominant rotation axis is not estimated
@@ -279,7 +371,9 @@ ClosedForm closed_form(const std::vector<MotionPair>& pairs, double max_sigma_m)
     (ts.matrixV().transpose() * ob.dominant_axis).cwiseAbs().maxCoeff(&normal);
   }
   for (int i = 0; i < 3; ++i) {
-    out.observability.translation_sigma_m[i] = sv[i] > 0 ? sigma_r / sv[i] : INFINITY;
+    const Eigen::Vector3d v = ts.matrixV().col(i);
+    out.observability.translation_sigma_m[i] =
+        sv[i] > 0 ? std::sqrt(std::max(0.0, v.dot(Sg * v))) / (sv[i] * sv[i]) : INFINITY;
     if (i == normal || sv[i] < 1e-3 * sv[0] ||
         out.observability.translation_sigma_m[i] > max_sigma_m) {
       out.observability.unobservable.push_back(i);

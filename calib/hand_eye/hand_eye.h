@@ -28,8 +28,10 @@ struct MotionPair {
 
 struct PairOptions {
   double spacing_s = 1.0;  // t1 - t0
-  // Between the starts of consecutive pairs; 0: spacing_s (pairs end to end, no shared pose).
-  double stride_s = 0.0;
+  // Between the starts of consecutive pairs; 0: spacing_s (pairs end to end). Overlapping pairs
+  // use more of the data (every 0.1 s: every LiDAR pose); the covariance does not count them as
+  // independent (refine's sandwich estimator).
+  double stride_s = 0.1;
   double min_rotation_deg = 1.0;  // pairs whose GNSS/INS rotation is smaller are dropped
   // The GNSS/INS clock: t_lidar = t_gnss + time_offset_s (its time_offset in the rig when the
   // LiDAR is on the base clock).
@@ -68,8 +70,9 @@ struct Observability {
   // determined by the data.
   Eigen::Vector3d translation_singular_values = Eigen::Vector3d::Zero();
   Eigen::Matrix3d translation_directions = Eigen::Matrix3d::Identity();
-  // 1-sigma of the translation along each of those directions, m: the RMS of the stacked
-  // residuals (per coordinate, with the degrees of freedom) over the singular value.
+  // 1-sigma of the translation along each of those directions, m, from the stacked residuals by
+  // the sandwich estimator with Bartlett weights over pairs that share fixes or overlap (see
+  // refine): sqrt(v^T S v) / s^2.
   Eigen::Vector3d translation_sigma_m = Eigen::Vector3d::Zero();
   // Directions (columns of translation_directions) the data do not determine: a 1-sigma above
   // max_sigma_m, a singular value below 1e-3 of the largest, or (near_planar) the one closest to
@@ -103,12 +106,19 @@ struct RefineOptions {
     double value_m = 0.0;
   };
   std::vector<Fixed> fixed;
+  // A scale factor on every LiDAR translation t_A, estimated with X: LiDAR odometry's scale error
+  // (tenths of a percent are common) would otherwise leak into the lever arm in every turn
+  // (simulated car at 10 m/s with 0.2 %: 2 cm in the plane).
+  bool estimate_scale = true;
 };
 
 struct Refined {
   SE3 T_gnss_lidar;
-  // 6 x 6 covariance: rotation (left tangent, rad: R = exp(d) R_X) then translation (m), scaled
-  // by the noise estimated from the residuals; fixed directions have (near) zero variance.
+  // 6 x 6 covariance: rotation (left tangent, rad: R = exp(d) R_X) then translation (m), by the
+  // sandwich H^-1 S H^-1 from the inlier pairs' residuals, S summing the products of pairs whose
+  // intervals touch or overlap with Bartlett weights (Newey-West): the noise level comes from the
+  // residuals, and pairs sharing a GNSS/INS fix or odometry steps are not counted as independent.
+  // Held directions have (near) zero variance.
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
   // Its diagonal as 1-sigmas: about the GNSS/INS frame's axes (deg), and of t (m).
   Eigen::Vector3d rotation_sigma_deg = Eigen::Vector3d::Zero();
@@ -119,6 +129,9 @@ struct Refined {
   // The per-pair noise levels the final solve used: estimated from the first solve's inlier
   // residuals (RMS per component), the given sigmas serving only as a start.
   double pair_rotation_noise_deg = 0.0, pair_translation_noise_m = 0.0;
+  // The odometry's scale correction (GNSS/INS distance over LiDAR distance) and its 1-sigma;
+  // 1 and 0 when not estimated.
+  double odometry_scale = 1.0, odometry_scale_sigma = 0.0;
 };
 
 // The unobservable directions of `observability` that no entry of `fixed` covers (|cos| > 0.9)

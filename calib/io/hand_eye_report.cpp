@@ -36,6 +36,7 @@ std::vector<OutputFile> hand_eye_report_files(const std::filesystem::path& dir,
                  {"rig", in.rig},
                  {"gnss_time_offset_s", in.gnss_time_offset_s},
                  {"spacing_s", in.spacing_s},
+                 {"stride_s", in.stride_s},
                  {"min_rotation_deg", in.min_rotation_deg}};
   j["T_gnss_lidar"] = {{"t_m", vec(X.t)},
                        {"roll_pitch_yaw_deg", vec(rpy)},
@@ -60,6 +61,12 @@ std::vector<OutputFile> hand_eye_report_files(const std::filesystem::path& dir,
       {"unobservable_directions", unobs},
       {"max_sigma_m", in.max_sigma_m}};
   j["noise_scale"] = r.noise_scale;
+  j["odometry_scale"] = {
+      {"definition",
+       "factor on every LiDAR odometry translation, estimated with the extrinsic (GNSS/INS "
+       "distance over odometry distance)"},
+      {"value", r.odometry_scale},
+      {"sigma", r.odometry_scale_sigma}};
   j["pair_noise"] = {
       {"definition",
        "RMS per component of the inlier pairs' residuals after a first solve with the given "

@@ -105,6 +105,7 @@ void apply_sim_config(std::string_view text, std::string_view file, sim::SimConf
       {"trajectories.gnss.horizontal_sigma_m", num(c.gnss.horizontal_sigma_m)},
       {"trajectories.gnss.vertical_sigma_m", num(c.gnss.vertical_sigma_m)},
       {"trajectories.gnss.rot_sigma_deg", num(c.gnss.rot_sigma_deg)},
+      {"trajectories.gnss.correlation_time_s", num(c.gnss.correlation_time_s)},
       {"trajectories.gnss.outages", spans(c.gnss.outages)},
       {"trajectories.gnss.outlier_probability", num(c.gnss.outlier_probability)},
       {"trajectories.gnss.outlier_jump_m", num(c.gnss.outlier_jump_m)},

@@ -68,6 +68,11 @@ Trajectory simulate_gnss(const PoseSource& source, double duration, Time base_st
   std::uniform_real_distribution<double> U(0.0, 1.0);
   Trajectory out;
   const double first_stamp = base_start.seconds() - noise.time_offset_s;
+  const double a = noise.correlation_time_s > 0
+                       ? std::exp(-1.0 / (noise.rate_hz * noise.correlation_time_s))
+                       : 0.0;
+  Eigen::Vector3d n_state = Eigen::Vector3d::Zero(), r_state = Eigen::Vector3d::Zero();
+  bool first = true;
   for (long k = 0;; ++k) {
     const double stamp = first_stamp + k / noise.rate_hz;
     const double t = stamp + noise.time_offset_s - base_start.seconds();
@@ -76,7 +81,12 @@ Trajectory simulate_gnss(const PoseSource& source, double duration, Time base_st
     bool outage = false;
     for (const auto& [from, to] : noise.outages) outage = outage || (t >= from && t < to);
     const bool outlier = U(rng) < noise.outlier_probability;
-    const Eigen::Vector3d n3(N(rng), N(rng), N(rng)), r3(N(rng), N(rng), N(rng));
+    const Eigen::Vector3d w3(N(rng), N(rng), N(rng)), v3(N(rng), N(rng), N(rng));
+    const double b = first ? 1.0 : std::sqrt(1.0 - a * a);
+    n_state = (first ? 0.0 : a) * n_state + b * w3;
+    r_state = (first ? 0.0 : a) * r_state + b * v3;
+    first = false;
+    const Eigen::Vector3d &n3 = n_state, &r3 = r_state;
     const Eigen::Vector3d jump(N(rng), N(rng), 0.3 * N(rng));
     if (outage) continue;
     SE3 T_enu_gnss = T_enu_world * source(t) * T_base_gnss;

@@ -30,6 +30,9 @@ struct GnssNoise {
   double horizontal_sigma_m = 0.02;  // RTK fixed
   double vertical_sigma_m = 0.03;
   double rot_sigma_deg = 0.05;
+  // 0: the position and attitude noise is white (independent at every fix); > 0: first-order
+  // Gauss-Markov with this correlation time, same sigmas (RTK errors drift over seconds).
+  double correlation_time_s = 0.0;
   double time_offset_s = 0.0;                      // the GNSS/INS clock: t_base = t_stamp + offset
   std::vector<std::pair<double, double>> outages;  // [from, to) s with no fixes
   double outlier_probability = 0.001;              // multipath jumps

@@ -26,7 +26,8 @@ struct ReplayRun {
   SE3 truth;  // T_gnss_lidar
   Eigen::Vector3d t_error = Eigen::Vector3d::Zero();
   double rotation_error_deg = 0;
-  std::vector<MotionPair> pairs;
+  std::vector<MotionPair> pairs;       // the default: 1 s every 0.1 s
+  std::vector<MotionPair> end_to_end;  // 1 s pairs end to end: stations for OpenCV
 };
 
 // OpenCV's calibrateHandEye on the stations the pairs chain into (GNSS/INS = gripper, LiDAR =
@@ -91,6 +92,9 @@ inline ReplayRun replay_vbr(const Trajectory& gt, uint64_t seed) {
   PairOptions po;
   po.time_offset_s = sync.offset_s;
   run.pairs = motion_pairs(part.odometry, part.gnss, po);
+  PairOptions end_to_end = po;
+  end_to_end.stride_s = 0;
+  run.end_to_end = motion_pairs(part.odometry, part.gnss, end_to_end);
   const std::vector<MotionPair>& pairs = run.pairs;
   run.closed = closed_form(pairs);
   RefineOptions ro;
