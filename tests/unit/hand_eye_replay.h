@@ -74,13 +74,14 @@ inline const std::vector<std::pair<cv::HandEyeCalibrationMethod, const char*>>& 
 
 // The sequence's ground truth; the unobservable directions (a car's vertical) held at the truth,
 // as `--fix` would with a measured value.
-inline ReplayRun replay_vbr(const Trajectory& gt, uint64_t seed) {
+inline ReplayRun replay_vbr(const Trajectory& gt, uint64_t seed, double rtk_correlation_s = 0.0) {
   rig::Rig rig = rig::read_rig_file(RIGCAL_SOURCE_DIR "/data/sample_rig.yaml");
   rig::sensor(rig, "gnss").T_base_sensor =
       SE3::from_rotation_vector({0.2, -0.15, 0.25}, {0.25, -0.12, 0.15});
   sim::SimConfig cfg;
   cfg.seed = seed;
   cfg.trajectory_duration_s = 1e9;  // the whole sequence
+  cfg.gnss.correlation_time_s = rtk_correlation_s;
   const sim::TrajectoryPart part = sim::simulate_trajectories(rig, cfg, &gt);
   ReplayRun run;
   run.truth = rig::T_a_b(rig, part.gnss_name, "lidar");
