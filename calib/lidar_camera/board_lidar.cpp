@@ -1,0 +1,285 @@
+#include "rigcal/lidar_camera/board_lidar.h"
+
+#include <fmt/format.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <random>
+#include <unordered_map>
+
+namespace rigcal::lidar_camera {
+
+Plane fit_plane(const std::vector<Eigen::Vector3d>& points, double* rms) {
+  const double N = static_cast<double>(points.size());
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : points) c += p;
+  c /= N;
+  Eigen::Matrix3d S = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3d& p : points) S += (p - c) * (p - c).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(S);  // ascending eigenvalues
+  Plane plane;
+  plane.n = es.eigenvectors().col(0);
+  plane.d = plane.n.dot(c);
+  if (plane.d < 0) plane.n = -plane.n, plane.d = -plane.d;
+  const double var = std::max(es.eigenvalues()[0], 0.0) / std::max(1.0, N - 3.0);
+  if (rms) *rms = std::sqrt(std::max(es.eigenvalues()[0], 0.0) / N);
+  // The normal's tilt about the in-plane principal axes e1, e2 has variance var / lambda_k; the
+  // offset along n at the centroid var / N, independent of the tilt.
+  const Eigen::Matrix<double, 3, 2> B = tangent(plane.n);
+  Eigen::Matrix3d info_inv = Eigen::Matrix3d::Zero();
+  for (int k = 1; k < 3; ++k) {
+    const Eigen::Vector3d e = es.eigenvectors().col(k);
+    info_inv += e * e.transpose() * (var / std::max(es.eigenvalues()[k], 1e-12));
+  }
+  Eigen::Matrix3d Cx = Eigen::Matrix3d::Zero();
+  Cx.block<2, 2>(0, 0) = B.transpose() * info_inv * B;
+  Cx(2, 2) = var / N;
+  Eigen::Matrix3d M = Eigen::Matrix3d::Identity();
+  M.block<1, 2>(2, 0) = c.transpose() * B;
+  plane.covariance = M * Cx * M.transpose();
+  return plane;
+}
+
+namespace {
+
+struct CellHash {
+  size_t operator()(const Eigen::Vector3i& v) const {
+    return (static_cast<size_t>(v.x()) * 73856093u) ^ (static_cast<size_t>(v.y()) * 19349663u) ^
+           (static_cast<size_t>(v.z()) * 83492791u);
+  }
+};
+struct CellEq {
+  bool operator()(const Eigen::Vector3i& a, const Eigen::Vector3i& b) const { return a == b; }
+};
+
+// Connected pieces of `idx` (points in the same or neighbouring cells join).
+std::vector<std::vector<size_t>> pieces(const std::vector<Eigen::Vector3d>& pts,
+                                        const std::vector<size_t>& idx, double cell) {
+  std::unordered_map<Eigen::Vector3i, std::vector<size_t>, CellHash, CellEq> cells;
+  for (size_t i : idx) cells[(pts[i] / cell).array().floor().cast<int>()].push_back(i);
+  std::unordered_map<Eigen::Vector3i, int, CellHash, CellEq> label;
+  std::vector<std::vector<size_t>> out;
+  for (const auto& [key, members] : cells) {
+    if (label.count(key)) continue;
+    const int id = static_cast<int>(out.size());
+    out.emplace_back();
+    std::vector<Eigen::Vector3i> stack{key};
+    label[key] = id;
+    while (!stack.empty()) {
+      const Eigen::Vector3i k = stack.back();
+      stack.pop_back();
+      const auto& m = cells.at(k);
+      out[id].insert(out[id].end(), m.begin(), m.end());
+      for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dz = -1; dz <= 1; ++dz) {
+            const Eigen::Vector3i nk = k + Eigen::Vector3i(dx, dy, dz);
+            if (cells.count(nk) && !label.count(nk)) {
+              label[nk] = id;
+              stack.push_back(nk);
+            }
+          }
+    }
+  }
+  return out;
+}
+
+struct Candidate {
+  std::vector<size_t> idx;
+  Eigen::Vector3d centre;
+  double w, h;
+  // The region in the piece's raster: cell (u - lo) / cell of B^T x, dilated by one cell.
+  cv::Mat region;
+  Eigen::Matrix<double, 3, 2> B;
+  Eigen::Vector2d lo;
+  double cell = 0.02;
+  bool contains(const Eigen::Vector3d& x) const {
+    const Eigen::Vector2d q = (B.transpose() * x - lo) / cell;
+    const int c = static_cast<int>(q.x()) + 1, r = static_cast<int>(q.y()) + 1;
+    return q.x() >= 0 && q.y() >= 0 && r < region.rows && c < region.cols &&
+           region.at<uint8_t>(r, c) != 0;
+  }
+};
+
+// The board-sized parts of one planar piece. The piece is rasterized in its plane (2 cm cells),
+// closed (gaps between rings filled), then opened with a kernel of half the board's short side,
+// which removes thin things joined to the board (its stand's post, a leg, a cable) but keeps a
+// board; each remaining region whose minimum-area rectangle has the board's size is a candidate,
+// with the piece's points that fall in it.
+std::vector<Candidate> board_shaped(const std::vector<Eigen::Vector3d>& all,
+                                    const std::vector<size_t>& piece, const Eigen::Vector3d& n,
+                                    double W, double H, const BoardSearch& s) {
+  const double cell = 0.02;
+  const Eigen::Matrix<double, 3, 2> B = tangent(n);
+  std::vector<Eigen::Vector2d> uv(piece.size());
+  Eigen::Vector2d lo(INFINITY, INFINITY), hi(-INFINITY, -INFINITY);
+  for (size_t k = 0; k < piece.size(); ++k) {
+    uv[k] = B.transpose() * all[piece[k]];
+    lo = lo.cwiseMin(uv[k]), hi = hi.cwiseMax(uv[k]);
+  }
+  const Eigen::Vector2d size = hi - lo;
+  // A piece smaller than the board's short side, or too large to hold it as a part worth a raster
+  // (walls, floors: their board-sized parts would be flat patches of wall), is skipped early.
+  if (std::max(size.x(), size.y()) < W - s.short_m || std::min(size.x(), size.y()) < H - s.short_m)
+    return {};
+  if (size.x() * size.y() > 16.0) return {};
+  const int cols = static_cast<int>(size.x() / cell) + 3,
+            rows = static_cast<int>(size.y() / cell) + 3;
+  cv::Mat mask = cv::Mat::zeros(rows, cols, CV_8U);
+  std::vector<cv::Point> at(piece.size());
+  for (size_t k = 0; k < piece.size(); ++k) {
+    at[k] = cv::Point(static_cast<int>((uv[k].x() - lo.x()) / cell) + 1,
+                      static_cast<int>((uv[k].y() - lo.y()) / cell) + 1);
+    mask.at<uint8_t>(at[k]) = 255;
+  }
+  const int close = 5, open = std::max(3, static_cast<int>(0.5 * H / cell));
+  cv::morphologyEx(mask, mask, cv::MORPH_CLOSE,
+                   cv::getStructuringElement(cv::MORPH_RECT, cv::Size(close, close)));
+  cv::morphologyEx(mask, mask, cv::MORPH_OPEN,
+                   cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(open, open)));
+  cv::Mat labels;
+  const int n_labels = cv::connectedComponents(mask, labels, 8, CV_32S);
+  std::vector<Candidate> out;
+  for (int l = 1; l < n_labels; ++l) {
+    std::vector<cv::Point2f> region;
+    Candidate c;
+    c.centre.setZero();
+    for (size_t k = 0; k < piece.size(); ++k) {
+      if (labels.at<int>(at[k]) != l) continue;
+      region.emplace_back(static_cast<float>(uv[k].x()), static_cast<float>(uv[k].y()));
+      c.idx.push_back(piece[k]);
+      c.centre += all[piece[k]];
+    }
+    if (c.idx.size() < static_cast<size_t>(s.min_points)) continue;
+    c.centre /= static_cast<double>(c.idx.size());
+    const cv::RotatedRect rect = cv::minAreaRect(region);
+    c.w = std::max(rect.size.width, rect.size.height);
+    c.h = std::min(rect.size.width, rect.size.height);
+    if (c.w < W - s.short_m || c.w > W + s.long_m || c.h < H - s.short_m || c.h > H + s.long_m)
+      continue;
+    cv::dilate(labels == l, c.region, cv::Mat::ones(3, 3, CV_8U));
+    c.B = B;
+    c.lo = lo;
+    c.cell = cell;
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
+}  // namespace
+
+LidarBoard find_board(const std::vector<Eigen::Vector3d>& all, const BoardSearch& s) {
+  LidarBoard out;
+  std::vector<size_t> remaining;
+  for (size_t i = 0; i < all.size(); ++i) {
+    const double r = all[i].norm();
+    if (!(r >= s.min_range_m && r <= s.max_range_m)) continue;
+    if (s.roi && ((all[i].array() < s.roi->first.array()).any() ||
+                  (all[i].array() > s.roi->second.array()).any()))
+      continue;
+    remaining.push_back(i);
+  }
+  const double W = std::max(s.board_width_m, s.board_height_m),
+               H = std::min(s.board_width_m, s.board_height_m);
+  std::mt19937_64 rng(s.seed);
+  std::vector<Candidate> candidates;
+  for (int plane = 0; plane < s.max_planes && remaining.size() >= static_cast<size_t>(s.min_points);
+       ++plane) {
+    std::uniform_int_distribution<size_t> pick(0, remaining.size() - 1);
+    size_t best_count = 0;
+    Eigen::Vector3d best_n = Eigen::Vector3d::UnitZ();
+    double best_d = 0;
+    for (int it = 0; it < 400; ++it) {
+      const Eigen::Vector3d &a = all[remaining[pick(rng)]], &b = all[remaining[pick(rng)]],
+                            &c = all[remaining[pick(rng)]];
+      Eigen::Vector3d n = (b - a).cross(c - a);
+      if (n.norm() < 1e-9) continue;
+      n.normalize();
+      const double d = n.dot(a);
+      size_t count = 0;
+      for (size_t i : remaining) count += std::abs(n.dot(all[i]) - d) < s.plane_threshold_m;
+      if (count > best_count) best_count = count, best_n = n, best_d = d;
+    }
+    if (best_count < static_cast<size_t>(s.min_points)) break;
+    std::vector<size_t> in, out_idx;
+    for (size_t i : remaining)
+      (std::abs(best_n.dot(all[i]) - best_d) < s.plane_threshold_m ? in : out_idx).push_back(i);
+    remaining.swap(out_idx);
+    for (std::vector<size_t>& piece : pieces(all, in, s.cell_m)) {
+      if (piece.size() < static_cast<size_t>(s.min_points)) continue;
+      for (Candidate& c : board_shaped(all, piece, best_n, W, H, s)) {
+        candidates.push_back(std::move(c));
+      }
+    }
+  }
+  out.candidates = static_cast<int>(candidates.size());
+  if (candidates.empty()) {
+    out.reason = fmt::format(
+        "no planar piece of the board's size ({:.2f} x {:.2f} m) between {} and {} m{}: "
+        "give --roi around the board",
+        W, H, s.min_range_m, s.max_range_m, s.roi ? " inside the ROI" : "");
+    return out;
+  }
+  const Candidate* best = nullptr;
+  if (s.expected_centre) {
+    double dmin = s.max_centre_distance_m;
+    for (const Candidate& c : candidates) {
+      const double d = (c.centre - *s.expected_centre).norm();
+      if (d <= dmin) dmin = d, best = &c;
+    }
+    if (!best) {
+      out.reason = fmt::format(
+          "{} planar pieces of the board's size, none within {} m of where the board is expected",
+          candidates.size(), s.max_centre_distance_m);
+      return out;
+    }
+  } else {
+    if (candidates.size() > 1) {
+      out.reason = fmt::format(
+          "{} planar pieces of the board's size and no expected position to choose among them",
+          candidates.size());
+      return out;
+    }
+    best = &candidates.front();
+  }
+  out.found = true;
+  // Refit, then gather again every point near the plane inside the region (board points another
+  // plane took come back; the stand's post, removed from the region by the opening, stays out),
+  // and refit dropping points beyond 2.5 RMS until nothing changes (a few mixed edge returns).
+  std::vector<Eigen::Vector3d> first;
+  for (size_t i : best->idx) first.push_back(all[i]);
+  double rms = 0;
+  Plane p0 = fit_plane(first, &rms);
+  double tol = std::clamp(3.0 * rms, 0.01, s.plane_threshold_m);
+  std::vector<Eigen::Vector3d> near;
+  for (const Eigen::Vector3d& x : all) {
+    if (std::abs(p0.n.dot(x) - p0.d) <= tol && best->contains(x)) near.push_back(x);
+  }
+  for (int it = 0; it < 5; ++it) {
+    p0 = fit_plane(near, &rms);
+    std::vector<Eigen::Vector3d> kept;
+    for (const Eigen::Vector3d& x : near) {
+      if (std::abs(p0.n.dot(x) - p0.d) <= 2.5 * rms) kept.push_back(x);
+    }
+    const bool same = kept.size() == near.size();
+    near.swap(kept);
+    if (same || near.size() < static_cast<size_t>(s.min_points)) break;
+  }
+  out.points = near;
+  out.plane = fit_plane(out.points, &out.plane_rms_m);
+  out.centre = best->centre;
+  out.width_m = best->w;
+  out.height_m = best->h;
+  out.reason = fmt::format("board found: {} points, {:.2f} x {:.2f} m, plane RMS {:.1f} mm{}",
+                           out.points.size(), out.width_m, out.height_m, 1e3 * out.plane_rms_m,
+                           candidates.size() > 1
+                               ? fmt::format(" ({} candidates, the nearest to the expected "
+                                             "position taken)",
+                                             candidates.size())
+                               : "");
+  return out;
+}
+
+}  // namespace rigcal::lidar_camera
