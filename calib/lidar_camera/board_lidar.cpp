@@ -185,33 +185,74 @@ LidarBoard find_board(const std::vector<Eigen::Vector3d>& all, const BoardSearch
                H = std::min(s.board_width_m, s.board_height_m);
   std::mt19937_64 rng(s.seed);
   std::vector<Candidate> candidates;
-  for (int plane = 0; plane < s.max_planes && remaining.size() >= static_cast<size_t>(s.min_points);
-       ++plane) {
-    std::uniform_int_distribution<size_t> pick(0, remaining.size() - 1);
+  // The best plane of `pool` by RANSAC: normal, offset and inlier count.
+  auto ransac = [&](const std::vector<size_t>& pool, Eigen::Vector3d& best_n, double& best_d) {
+    std::uniform_int_distribution<size_t> pick(0, pool.size() - 1);
     size_t best_count = 0;
-    Eigen::Vector3d best_n = Eigen::Vector3d::UnitZ();
-    double best_d = 0;
-    for (int it = 0; it < 400; ++it) {
-      const Eigen::Vector3d &a = all[remaining[pick(rng)]], &b = all[remaining[pick(rng)]],
-                            &c = all[remaining[pick(rng)]];
+    for (int it = 0; it < 300; ++it) {
+      const Eigen::Vector3d &a = all[pool[pick(rng)]], &b = all[pool[pick(rng)]],
+                            &c = all[pool[pick(rng)]];
       Eigen::Vector3d n = (b - a).cross(c - a);
       if (n.norm() < 1e-9) continue;
       n.normalize();
       const double d = n.dot(a);
       size_t count = 0;
-      for (size_t i : remaining) count += std::abs(n.dot(all[i]) - d) < s.plane_threshold_m;
+      for (size_t i : pool) count += std::abs(n.dot(all[i]) - d) < s.plane_threshold_m;
       if (count > best_count) best_count = count, best_n = n, best_d = d;
     }
-    if (best_count < static_cast<size_t>(s.min_points)) break;
-    std::vector<size_t> in, out_idx;
-    for (size_t i : remaining)
-      (std::abs(best_n.dot(all[i]) - best_d) < s.plane_threshold_m ? in : out_idx).push_back(i);
-    remaining.swap(out_idx);
+    return best_count;
+  };
+  auto split = [&](const std::vector<size_t>& pool, const Eigen::Vector3d& n, double d,
+                   std::vector<size_t>& in, std::vector<size_t>& rest) {
+    for (size_t i : pool)
+      (std::abs(n.dot(all[i]) - d) < s.plane_threshold_m ? in : rest).push_back(i);
+  };
+  const double diagonal = std::hypot(W, H);
+  // 1. The large planes (floor, walls, ceiling): RANSAC over the whole scan; a plane's pieces
+  //    larger than 3 board diagonals and 3 m are removed, smaller ones (a board on its stand, a
+  //    board that happens to lie in a wall's plane, clutter) go back. A small board among tens of
+  //    thousands of points would never win a global RANSAC; it is looked for in step 2.
+  for (int plane = 0; plane < s.max_planes && remaining.size() >= static_cast<size_t>(s.min_points);
+       ++plane) {
+    Eigen::Vector3d n;
+    double d = 0;
+    if (ransac(remaining, n, d) < static_cast<size_t>(s.min_points)) break;
+    std::vector<size_t> in, rest;
+    split(remaining, n, d, in, rest);
+    bool removed = false;
     for (std::vector<size_t>& piece : pieces(all, in, s.cell_m)) {
-      if (piece.size() < static_cast<size_t>(s.min_points)) continue;
-      for (Candidate& c : board_shaped(all, piece, best_n, W, H, s)) {
-        candidates.push_back(std::move(c));
+      Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
+      for (size_t i : piece) lo = lo.cwiseMin(all[i]), hi = hi.cwiseMax(all[i]);
+      if ((hi - lo).norm() > std::max(3.0 * diagonal, 3.0)) {
+        removed = true;
+      } else {
+        rest.insert(rest.end(), piece.begin(), piece.end());
       }
+    }
+    remaining.swap(rest);
+    if (!removed) break;
+  }
+  // 2. What is left, in connected clusters; in each cluster of a plausible size (a board on a
+  //    stand, a person holding it), up to three planes, each tested for the board's shape.
+  for (const std::vector<size_t>& cluster : pieces(all, remaining, s.cell_m)) {
+    if (cluster.size() < static_cast<size_t>(s.min_points)) continue;
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
+    for (size_t i : cluster) lo = lo.cwiseMin(all[i]), hi = hi.cwiseMax(all[i]);
+    const double extent = (hi - lo).norm();
+    if (extent < 0.5 * diagonal || extent > 4.0 * diagonal + 1.0) continue;
+    std::vector<size_t> pool = cluster;
+    for (int k = 0; k < 3 && pool.size() >= static_cast<size_t>(s.min_points); ++k) {
+      Eigen::Vector3d n;
+      double d = 0;
+      if (ransac(pool, n, d) < static_cast<size_t>(s.min_points)) break;
+      std::vector<size_t> in, rest;
+      split(pool, n, d, in, rest);
+      for (std::vector<size_t>& piece : pieces(all, in, s.cell_m)) {
+        if (piece.size() < static_cast<size_t>(s.min_points)) continue;
+        for (Candidate& c : board_shaped(all, piece, n, W, H, s))
+          candidates.push_back(std::move(c));
+      }
+      pool.swap(rest);
     }
   }
   out.candidates = static_cast<int>(candidates.size());

@@ -37,6 +37,25 @@ Eigen::Matrix3d residual_covariance(const BoardPair& p, const SE3& T) {
 
 }  // namespace
 
+std::vector<PairResidual> residuals_at(const std::vector<BoardPair>& pairs, const SE3& T) {
+  std::vector<PairResidual> out;
+  for (const BoardPair& p : pairs) {
+    PairResidual pr;
+    const Eigen::Vector3d r = residual(p, T);
+    pr.chi2 = r.dot(residual_covariance(p, T).ldlt().solve(r));
+    pr.outlier = pr.chi2 > 16.27;
+    const Eigen::Vector3d n = T.R * p.lidar.n;
+    pr.normal_angle_deg = std::acos(std::clamp(n.dot(p.camera.n), -1.0, 1.0)) * 180 / M_PI;
+    pr.distance_m = r[2];
+    double s2 = 0;
+    for (const Eigen::Vector3d& x : p.lidar_points)
+      s2 += std::pow(p.camera.n.dot(T * x) - p.camera.d, 2);
+    pr.point_rms_m = p.lidar_points.empty() ? 0.0 : std::sqrt(s2 / p.lidar_points.size());
+    out.push_back(pr);
+  }
+  return out;
+}
+
 Observability observability(const std::vector<BoardPair>& pairs, double max_condition) {
   Observability o;
   Eigen::MatrixXd N(pairs.size(), 3);
@@ -117,23 +136,11 @@ Solution solve(const std::vector<BoardPair>& pairs, double huber) {
     if (step.norm() < 1e-12) break;
   }
   out.T_camera_lidar = T;
+  out.residuals = residuals_at(pairs, T);
   double ss = 0;
   size_t n_in = 0;
-  for (size_t k = 0; k < pairs.size(); ++k) {
-    const BoardPair& p = pairs[k];
-    PairResidual pr;
-    const Eigen::Vector3d r = residual(p, T);
-    pr.chi2 = (W[k] * r).squaredNorm();
-    pr.outlier = pr.chi2 > 16.27;
-    const Eigen::Vector3d n = T.R * p.lidar.n;
-    pr.normal_angle_deg = std::acos(std::clamp(n.dot(p.camera.n), -1.0, 1.0)) * 180 / M_PI;
-    pr.distance_m = r[2];
-    double s2 = 0;
-    for (const Eigen::Vector3d& x : p.lidar_points)
-      s2 += std::pow(p.camera.n.dot(T * x) - p.camera.d, 2);
-    pr.point_rms_m = p.lidar_points.empty() ? 0.0 : std::sqrt(s2 / p.lidar_points.size());
+  for (const PairResidual& pr : out.residuals) {
     if (!pr.outlier) ss += pr.chi2, ++n_in;
-    out.residuals.push_back(pr);
   }
   const double dof = std::max(1.0, 3.0 * static_cast<double>(n_in) - 6.0);
   out.noise_scale = std::sqrt(ss / dof);

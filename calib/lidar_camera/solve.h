@@ -57,6 +57,11 @@ struct Solution {
 // Throws rigcal::Error when the boards do not determine the extrinsic (observability().reason).
 Solution solve(const std::vector<BoardPair>& pairs, double huber = 3.0);
 
+// The residuals of the boards under a given extrinsic (another tool's, an old calibration's):
+// how well it makes the two sensors' planes agree.
+std::vector<PairResidual> residuals_at(const std::vector<BoardPair>& pairs,
+                                       const SE3& T_camera_lidar);
+
 // One image + scan pair as the pipeline sees it: the camera's board (from the corners) and the
 // scan's points (LiDAR frame).
 struct PairInput {

@@ -13,6 +13,7 @@
 
 #include "fixtures.h"
 #include "rigcal/io/trajectory_io.h"
+#include "rigcal/rig/rig_yaml.h"
 
 namespace {
 
@@ -557,6 +558,48 @@ TEST_F(Cli, HandEyeReadsGnssFixes) {
   r = run("hand-eye" + lidar + " --gnss " + bad2.string() + " --attitude enu");
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("bad2.csv:3: latitude 141.9"), std::string::npos) << r.err;
+}
+
+// rigcal lidar-camera on a simulated session: the rig written (cam_r placed, cam_l following
+// through the stereo extrinsic), the report with a quick-look PNG per pair; bad input: exit 2,
+// nothing written.
+TEST_F(Cli, LidarCameraWritesTheRigAndRefusesTooFewBoards) {
+  const fs::path sim = dir_ / "sim";
+  ASSERT_EQ(run("simulate --what lidar-camera --out " + sim.string()).status, 0);
+  const std::string target = RIGCAL_SOURCE_DIR "/targets/a3_checkerboard_8x5_40mm.yaml";
+  const std::string out = (dir_ / "out.yaml").string(), rep = (dir_ / "rep").string();
+  CliRun r = run("lidar-camera --target " + target + " --rig " + kSample + " --session " +
+                 sim.string() + " --out " + out + " --report " + rep);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(run("rig validate " + out).status, 0);
+  const nlohmann::json j = nlohmann::json::parse(slurp(fs::path(rep) / "lidar_camera.json"));
+  ASSERT_EQ(j["pairs"].size(), 10u);
+  for (const auto& p : j["pairs"]) EXPECT_TRUE(p["used"].get<bool>()) << p["note"];
+  EXPECT_TRUE(fs::exists(fs::path(rep) / "pair_01.png"));
+  // The written rig against the sample rig (the simulator's truth): cam_r within 5 mm, and the
+  // stereo extrinsic unchanged.
+  namespace rig = rigcal::rig;
+  const rig::Rig truth = rig::read_rig_file(kSample), got = rig::read_rig_file(out);
+  EXPECT_LT((rig::T_a_b(got, "cam_r", "lidar").t - rig::T_a_b(truth, "cam_r", "lidar").t).norm(),
+            0.005);
+  EXPECT_LT((rig::T_a_b(got, "cam_r", "cam_l").t - rig::T_a_b(truth, "cam_r", "cam_l").t).norm(),
+            1e-9);
+  // Two pairs: no calibration, nothing written.
+  const std::string out2 = (dir_ / "out2.yaml").string();
+  const std::string lc = sim.string() + "/lidar_camera/";
+  r = run("lidar-camera --target " + target + " --rig " + kSample + " --images '" + lc +
+          "camera_right/data/000000000[01].png' --scans '" + lc +
+          "ouster_points/data/000000000[01].bin' --out " + out2);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("at least 3"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out2));
+  // A scan without its image.
+  r = run("lidar-camera --target " + target + " --rig " + kSample + " --images '" + lc +
+          "camera_right/data/000000000[01].png' --scans '" + lc +
+          "ouster_points/data/000000000[012].bin' --out " + out2);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("has no image with the same frame number"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out2));
 }
 
 TEST_F(Cli, HandEyeWritesTheExtrinsicAndRefusesAnUndeterminedDirection) {

@@ -1,0 +1,16 @@
+#pragma once
+// Point clouds (doc/formats.md): KITTI-style .bin (float32 x, y, z, intensity per point) and PCD
+// v0.7 (DATA ascii or binary; fields x, y, z required, others skipped; binary_compressed is
+// refused with a message). Points with no return, stored as (0, 0, 0) or NaN, are dropped.
+// rigcal reads PCD itself rather than through PCL: the two layouts are a page of code, and PCL's
+// io pulls 300 Debian packages into a clean install.
+#include <Eigen/Core>
+#include <filesystem>
+#include <vector>
+
+namespace rigcal::io {
+
+// By extension: .bin (KITTI) or .pcd. Throws rigcal::Error naming the file and what is wrong.
+std::vector<Eigen::Vector3d> read_point_cloud(const std::filesystem::path& path);
+
+}  // namespace rigcal::io
