@@ -17,8 +17,9 @@ struct BoardSearch {
   double plane_threshold_m = 0.03;  // RANSAC inlier distance
   double cell_m = 0.1;              // connectivity: points in neighbouring cells join
   // A piece matches when each side of its rectangle is within [size - short_m, size + long_m]:
-  // LiDAR rings sample the board's edges late (up to one ring gap short), never long.
-  double short_m = 0.12, long_m = 0.06;
+  // LiDAR rings sample the board's edges late (up to one ring gap short); the 2 cm raster and a
+  // stub of the stand can add a few centimetres.
+  double short_m = 0.12, long_m = 0.10;
   int min_points = 30;
   int max_planes = 15;
   uint64_t seed = 1;
