@@ -40,7 +40,7 @@ echo "Benchmark report (bench.json, trajectory_top.svg, ate_along.svg) in $out/b
 
 echo
 echo "== simulated session of the sample rig (truth in $out/sim/truth.yaml and truth.json)"
-printf "stereo:\n  views: 12\nscans:\n  count: 3\nlidar_camera:\n  pairs: 3\n" > "$out/sim.yaml"
+printf "stereo:\n  views: 12\nscans:\n  count: 3\nlidar_camera:\n  pairs: 8\n" > "$out/sim.yaml"
 "$rigcal" simulate --out "$out/sim" --config "$out/sim.yaml"
 echo
 "$rigcal" bench --gt "$out/sim/trajectories/truth_lidar.tum" \
@@ -56,3 +56,16 @@ echo
 echo "== clock offset between the simulated session's two IMUs (truth: imu time_offset -0.0031 s)"
 "$rigcal" time-offset --session "$out/sim" --rig "$out/cameras/calib.yaml" \
   --out "$out/time_offset/calib.yaml" --report "$out/time_offset/report"
+
+echo
+echo "== LiDAR-camera extrinsic from the simulated board pairs (truth: the sample rig's cam_r)"
+"$rigcal" lidar-camera --session "$out/sim" --target "$root/targets/a3_checkerboard_8x5_40mm.yaml" \
+  --rig "$out/time_offset/calib.yaml" --out "$out/lidar_camera/calib.yaml" \
+  --report "$out/lidar_camera/report"
+
+echo
+echo "== GNSS/INS-to-LiDAR extrinsic from the simulated trajectories (truth: the sample rig's gnss)"
+"$rigcal" hand-eye --lidar "$out/sim/trajectories/lidar_odometry.tum" \
+  --gnss "$out/sim/trajectories/gnss_ins.tum" --rig "$out/lidar_camera/calib.yaml" \
+  --estimate-offset --out "$out/hand_eye/calib.yaml" --report "$out/hand_eye/report"
+echo "The session's calibration, step by step: $out/hand_eye/calib.yaml"
