@@ -42,6 +42,52 @@ Plane fit_plane(const std::vector<Eigen::Vector3d>& points, double* rms) {
   return plane;
 }
 
+Plane fit_plane_along_rays(const std::vector<Eigen::Vector3d>& points, double* rms) {
+  Plane plane = fit_plane(points);
+  // Parameters: two tangent angles (n <- normalize(n + a u + b v)) and d.
+  auto residuals = [&](const Eigen::Vector3d& n, double d) {
+    Eigen::VectorXd r(points.size());
+    for (size_t i = 0; i < points.size(); ++i) {
+      const double cosine = n.dot(points[i]) / points[i].norm();
+      r[i] = (d - n.dot(points[i])) / (std::abs(cosine) > 0.05 ? cosine : 0.05);
+    }
+    return r;
+  };
+  Eigen::MatrixXd J(points.size(), 3);
+  Eigen::Matrix3d JtJ = Eigen::Matrix3d::Identity();
+  for (int it = 0; it < 10; ++it) {
+    const Eigen::Matrix<double, 3, 2> B = tangent(plane.n);
+    const Eigen::VectorXd r = residuals(plane.n, plane.d);
+    const double h = 1e-7;
+    for (int c = 0; c < 3; ++c) {
+      Eigen::Vector3d dp = Eigen::Vector3d::Zero();
+      dp[c] = h;
+      const Eigen::Vector3d n1 = (plane.n + B * dp.head<2>()).normalized();
+      J.col(c) = (residuals(n1, plane.d + dp[2]) - r) / h;
+    }
+    JtJ = J.transpose() * J;
+    const Eigen::Vector3d step = JtJ.ldlt().solve(-J.transpose() * r);
+    plane.n = (plane.n + B * step.head<2>()).normalized();
+    plane.d += step[2];
+    if (step.norm() < 1e-12) break;
+  }
+  if (plane.d < 0) plane.n = -plane.n, plane.d = -plane.d;
+  const Eigen::VectorXd r = residuals(plane.n, plane.d);
+  const double N = static_cast<double>(points.size());
+  const double var = r.squaredNorm() / std::max(1.0, N - 3.0);
+  if (rms) *rms = std::sqrt(r.squaredNorm() / N);
+  // J at the solution, in the tangent basis of the final n (the covariance's convention).
+  const Eigen::Matrix<double, 3, 2> B = tangent(plane.n);
+  for (int c = 0; c < 3; ++c) {
+    Eigen::Vector3d dp = Eigen::Vector3d::Zero();
+    dp[c] = 1e-7;
+    const Eigen::Vector3d n1 = (plane.n + B * dp.head<2>()).normalized();
+    J.col(c) = (residuals(n1, plane.d + dp[2]) - r) / 1e-7;
+  }
+  plane.covariance = var * (J.transpose() * J).inverse();
+  return plane;
+}
+
 namespace {
 
 struct CellHash {
@@ -289,27 +335,33 @@ LidarBoard find_board(const std::vector<Eigen::Vector3d>& all, const BoardSearch
   // Refit, then gather again every point near the plane inside the region (board points another
   // plane took come back; the stand's post, removed from the region by the opening, stays out),
   // and refit dropping points beyond 2.5 RMS until nothing changes (a few mixed edge returns).
+  // Distances are along the rays (the range each point would need), as the noise is: a window
+  // symmetric about a plane tilted by the orthogonal fit's bias would keep that bias.
   std::vector<Eigen::Vector3d> first;
   for (size_t i : best->idx) first.push_back(all[i]);
   double rms = 0;
-  Plane p0 = fit_plane(first, &rms);
-  double tol = std::clamp(3.0 * rms, 0.01, s.plane_threshold_m);
+  Plane p0 = fit_plane_along_rays(first, &rms);
+  auto range_residual = [](const Plane& p, const Eigen::Vector3d& x) {
+    const double cosine = p.n.dot(x) / x.norm();
+    return (p.d - p.n.dot(x)) / (std::abs(cosine) > 0.05 ? cosine : 0.05);
+  };
+  const double tol = std::clamp(3.0 * rms, 0.01, s.plane_threshold_m);
   std::vector<Eigen::Vector3d> near;
   for (const Eigen::Vector3d& x : all) {
-    if (std::abs(p0.n.dot(x) - p0.d) <= tol && best->contains(x)) near.push_back(x);
+    if (std::abs(range_residual(p0, x)) <= tol && best->contains(x)) near.push_back(x);
   }
-  for (int it = 0; it < 5; ++it) {
-    p0 = fit_plane(near, &rms);
+  for (int it = 0; it < 5 && near.size() >= static_cast<size_t>(s.min_points); ++it) {
+    p0 = fit_plane_along_rays(near, &rms);
     std::vector<Eigen::Vector3d> kept;
     for (const Eigen::Vector3d& x : near) {
-      if (std::abs(p0.n.dot(x) - p0.d) <= 2.5 * rms) kept.push_back(x);
+      if (std::abs(range_residual(p0, x)) <= 2.5 * rms) kept.push_back(x);
     }
     const bool same = kept.size() == near.size();
     near.swap(kept);
-    if (same || near.size() < static_cast<size_t>(s.min_points)) break;
+    if (same) break;
   }
   out.points = near;
-  out.plane = fit_plane(out.points, &out.plane_rms_m);
+  out.plane = fit_plane_along_rays(out.points, &out.plane_rms_m);
   out.centre = best->centre;
   out.width_m = best->w;
   out.height_m = best->h;

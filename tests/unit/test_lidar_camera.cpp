@@ -29,9 +29,9 @@ double rotation_error_deg(const SE3& a, const SE3& b) {
 
 // Acceptance 2 and part of 1 (seed 1): 10 pairs with a person-sized box next to the board: the
 // board is found in every scan; translation <= 5 mm and within 3 reported sigmas. The rotation
-// bar (0.1 deg) is not met reliably: over 20 seeds (make test-long) the error is 0.02-0.32 deg
-// with a systematic part of about +0.12 deg about the camera's x axis whose cause is not found
-// yet (doc/lidar-camera.md); here it is held to 0.25 deg so that a regression shows.
+// bar (0.1 deg) is not met reliably: over 20 seeds (make test-long) the error is 0.03-0.28 deg
+// with a systematic part of about +0.07 deg about the camera's x axis whose cause is not found
+// yet (doc/lidar-camera.md); here it is held to 0.1 deg on this seed (0.052 deg measured).
 TEST(LidarCameraSim, TenPairsWithClutter) {
   const testing::SimRun r = testing::simulate_and_solve(1);
   const Solution& s = r.solution;
@@ -51,7 +51,7 @@ TEST(LidarCameraSim, TenPairsWithClutter) {
                 1e3 * p.distance_m, 1e3 * p.point_rms_m, p.outlier ? " (outlier)" : "");
   }
   EXPECT_EQ(r.found, r.pairs);
-  EXPECT_LE(rot, 0.25);
+  EXPECT_LE(rot, 0.1);
   EXPECT_LE(e.norm(), 0.005);
   for (int i = 0; i < 3; ++i) EXPECT_LE(std::abs(e[i]), 3 * s.translation_sigma_m[i]) << i;
 }
