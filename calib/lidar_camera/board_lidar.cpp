@@ -279,7 +279,7 @@ LidarBoard find_board(const std::vector<Eigen::Vector3d>& all, const BoardSearch
     if (!removed) break;
   }
   // 2. What is left, in connected clusters; in each cluster of a plausible size (a board on a
-  //    stand, a person holding it), up to three planes, each tested for the board's shape.
+  //    stand, a person holding it), up to five planes, each tested for the board's shape.
   for (const std::vector<size_t>& cluster : pieces(all, remaining, s.cell_m)) {
     if (cluster.size() < static_cast<size_t>(s.min_points)) continue;
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
@@ -287,12 +287,20 @@ LidarBoard find_board(const std::vector<Eigen::Vector3d>& all, const BoardSearch
     const double extent = (hi - lo).norm();
     if (extent < 0.5 * diagonal || extent > 4.0 * diagonal + 1.0) continue;
     std::vector<size_t> pool = cluster;
-    for (int k = 0; k < 3 && pool.size() >= static_cast<size_t>(s.min_points); ++k) {
+    for (int k = 0; k < 5 && pool.size() >= static_cast<size_t>(s.min_points); ++k) {
       Eigen::Vector3d n;
       double d = 0;
       if (ransac(pool, n, d) < static_cast<size_t>(s.min_points)) break;
       std::vector<size_t> in, rest;
       split(pool, n, d, in, rest);
+      // The RANSAC plane refitted on its inliers and the inliers taken again: a plane through
+      // three noisy points can cut a board obliquely and split it.
+      std::vector<Eigen::Vector3d> inlier_points;
+      for (size_t i : in) inlier_points.push_back(all[i]);
+      const Plane refit = fit_plane(inlier_points);
+      in.clear(), rest.clear();
+      split(pool, refit.n, refit.d, in, rest);
+      n = refit.n;
       for (std::vector<size_t>& piece : pieces(all, in, s.cell_m)) {
         if (piece.size() < static_cast<size_t>(s.min_points)) continue;
         for (Candidate& c : board_shaped(all, piece, n, W, H, s))
