@@ -104,6 +104,10 @@ double orthonormality_error(const Eigen::Matrix3d& R) {
   return (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
 }
 
+SE3 perturbed(const SE3& T, const Eigen::Matrix<double, 6, 1>& d) {
+  return SE3{rotation_from_vector(d.head<3>()) * T.R, T.t + d.tail<3>()};
+}
+
 Eigen::Matrix3d nearest_rotation(const Eigen::Matrix3d& M) {
   Eigen::JacobiSVD<Eigen::Matrix3d> svd(M, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::Matrix3d D = Eigen::Matrix3d::Identity();

@@ -47,6 +47,9 @@ double orthonormality_error(const Eigen::Matrix3d& R);
 // The rotation closest to M in the Frobenius norm (SVD projection).
 Eigen::Matrix3d nearest_rotation(const Eigen::Matrix3d& M);
 Eigen::Matrix3d skew(const Eigen::Vector3d& v);
+// T moved by d = (rotation vector, translation): R' = exp(d_rot) R, t' = t + d_t. The tangent
+// every 6 x 6 covariance of a pose in rigcal is expressed in (rotation first, left perturbation).
+SE3 perturbed(const SE3& T, const Eigen::Matrix<double, 6, 1>& d);
 
 // Text form "tx ty tz qx qy qz qw" (the TUM order), numbers in shortest round-trip form.
 std::string to_text(const SE3& T_a_b);

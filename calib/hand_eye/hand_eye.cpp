@@ -126,7 +126,7 @@ Eigen::Matrix<double, 7, 7> sandwich_covariance(const std::vector<MotionPair>& p
   using Mat67 = Eigen::Matrix<double, 6, 7>;
   using Mat7 = Eigen::Matrix<double, 7, 7>;
   auto residual = [&](const MotionPair& p, const Vec7& d) {
-    const SE3 Xd{rotation_from_vector(d.head<3>()) * X.R, X.t + d.segment<3>(3)};
+    const SE3 Xd = perturbed(X, d.head<6>());
     const double sd = scale + d[6];
     const PairError e{p.A.quaternion(), p.B.quaternion(), p.A.t, p.B.t, rot_sigma, trans_sigma};
     const Eigen::Quaterniond q = Xd.quaternion();
@@ -312,10 +312,7 @@ ClosedForm closed_form(const std::vector<MotionPair>& pairs, double max_sigma_m)
     H += b * a.transpose();
     S += a * a.transpose();
   }
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
-  D(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1.0 : 1.0;
-  const Eigen::Matrix3d R = svd.matrixU() * D * svd.matrixV().transpose();
+  const Eigen::Matrix3d R = nearest_rotation(H);  // Kabsch
   const Eigen::JacobiSVD<Eigen::Matrix3d> axes(S, Eigen::ComputeFullU);
   Observability& ob = out.observability;
   ob.rotation_singular_values = axes.singularValues().cwiseSqrt();

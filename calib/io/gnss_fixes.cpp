@@ -11,6 +11,7 @@
 #include <fstream>
 
 #include "rigcal/core/error.h"
+#include "rigcal/core/se3.h"
 #include "rigcal/core/text.h"
 #include "rigcal/core/time.h"
 #include "rigcal/io/files.h"
@@ -27,13 +28,6 @@ std::string lower(std::string_view s) {
 double median(std::vector<double> v) {
   std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
   return v[v.size() / 2];
-}
-
-Eigen::Matrix3d rpy(double roll, double pitch, double yaw) {
-  return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
-          Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
-          Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
-      .toRotationMatrix();
 }
 
 // The header's column index of each name (first of its aliases), -1 when absent.
@@ -161,7 +155,8 @@ GnssFixes parse_gnss_fixes(std::string_view text, std::string_view file_name, At
     SE3 T;
     enu.Forward(lat, lon, h, T.t.x(), T.t.y(), T.t.z());
     const double roll = value(kRoll) * deg, pitch = value(kPitch) * deg, yaw = value(kYaw) * deg;
-    T.R = attitude == Attitude::enu ? rpy(roll, pitch, yaw) : R_enu_ned * rpy(roll, pitch, yaw);
+    T.R = attitude == Attitude::enu ? from_roll_pitch_yaw(roll, pitch, yaw)
+                                    : R_enu_ned * from_roll_pitch_yaw(roll, pitch, yaw);
     out.T_enu_gnss.stamps.push_back(stamp);
     out.T_enu_gnss.T_world_body.push_back(T);
     if (col[kStdE] >= 0 && col[kStdN] >= 0) std_h.push_back(std::hypot(value(kStdE), value(kStdN)));

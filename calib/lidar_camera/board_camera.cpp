@@ -25,10 +25,6 @@ namespace {
 
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 
-SE3 perturbed(const SE3& T, const Vec6& d) {
-  return SE3{rotation_from_vector(d.head<3>()) * T.R, T.t + d.tail<3>()};
-}
-
 // Reprojection residuals (pixels, 2 per corner); a point behind the camera gets a large residual.
 Eigen::VectorXd residuals(const rig::CameraModel& camera, const SE3& T,
                           const std::vector<Eigen::Vector3d>& object,

@@ -11,7 +11,7 @@
 
 namespace rigcal::lidar_camera {
 
-Plane fit_plane(const std::vector<Eigen::Vector3d>& points, double* rms) {
+Plane fit_plane(const std::vector<Eigen::Vector3d>& points) {
   const double N = static_cast<double>(points.size());
   Eigen::Vector3d c = Eigen::Vector3d::Zero();
   for (const Eigen::Vector3d& p : points) c += p;
@@ -24,7 +24,6 @@ Plane fit_plane(const std::vector<Eigen::Vector3d>& points, double* rms) {
   plane.d = plane.n.dot(c);
   if (plane.d < 0) plane.n = -plane.n, plane.d = -plane.d;
   const double var = std::max(es.eigenvalues()[0], 0.0) / std::max(1.0, N - 3.0);
-  if (rms) *rms = std::sqrt(std::max(es.eigenvalues()[0], 0.0) / N);
   // The normal's tilt about the in-plane principal axes e1, e2 has variance var / lambda_k; the
   // offset along n at the centroid var / N, independent of the tilt.
   const Eigen::Matrix<double, 3, 2> B = tangent(plane.n);
@@ -42,15 +41,23 @@ Plane fit_plane(const std::vector<Eigen::Vector3d>& points, double* rms) {
   return plane;
 }
 
+namespace {
+
+// The range a LiDAR point x (sensor at the origin) would need to lie on the plane n . x = d,
+// minus its range: the plane's residual in the units of the noise.
+double range_residual(const Eigen::Vector3d& n, double d, const Eigen::Vector3d& x) {
+  const double cosine = n.dot(x) / x.norm();
+  return (d - n.dot(x)) / (std::abs(cosine) > 0.05 ? cosine : 0.05);
+}
+
+}  // namespace
+
 Plane fit_plane_along_rays(const std::vector<Eigen::Vector3d>& points, double* rms) {
   Plane plane = fit_plane(points);
   // Parameters: two tangent angles (n <- normalize(n + a u + b v)) and d.
   auto residuals = [&](const Eigen::Vector3d& n, double d) {
     Eigen::VectorXd r(points.size());
-    for (size_t i = 0; i < points.size(); ++i) {
-      const double cosine = n.dot(points[i]) / points[i].norm();
-      r[i] = (d - n.dot(points[i])) / (std::abs(cosine) > 0.05 ? cosine : 0.05);
-    }
+    for (size_t i = 0; i < points.size(); ++i) r[i] = range_residual(n, d, points[i]);
     return r;
   };
   Eigen::MatrixXd J(points.size(), 3);
@@ -349,20 +356,16 @@ LidarBoard find_board(const std::vector<Eigen::Vector3d>& all, const BoardSearch
   for (size_t i : best->idx) first.push_back(all[i]);
   double rms = 0;
   Plane p0 = fit_plane_along_rays(first, &rms);
-  auto range_residual = [](const Plane& p, const Eigen::Vector3d& x) {
-    const double cosine = p.n.dot(x) / x.norm();
-    return (p.d - p.n.dot(x)) / (std::abs(cosine) > 0.05 ? cosine : 0.05);
-  };
   const double tol = std::clamp(3.0 * rms, 0.01, s.plane_threshold_m);
   std::vector<Eigen::Vector3d> near;
   for (const Eigen::Vector3d& x : all) {
-    if (std::abs(range_residual(p0, x)) <= tol && best->contains(x)) near.push_back(x);
+    if (std::abs(range_residual(p0.n, p0.d, x)) <= tol && best->contains(x)) near.push_back(x);
   }
   for (int it = 0; it < 5 && near.size() >= static_cast<size_t>(s.min_points); ++it) {
     p0 = fit_plane_along_rays(near, &rms);
     std::vector<Eigen::Vector3d> kept;
     for (const Eigen::Vector3d& x : near) {
-      if (std::abs(range_residual(p0, x)) <= 2.5 * rms) kept.push_back(x);
+      if (std::abs(range_residual(p0.n, p0.d, x)) <= 2.5 * rms) kept.push_back(x);
     }
     const bool same = kept.size() == near.size();
     near.swap(kept);

@@ -46,7 +46,7 @@ LidarBoard find_board(const std::vector<Eigen::Vector3d>& points, const BoardSea
 
 // Least-squares plane of points (centroid, smallest principal direction), d >= 0, with the
 // covariance of (tangent angles, d) from the residual scatter.
-Plane fit_plane(const std::vector<Eigen::Vector3d>& points, double* rms = nullptr);
+Plane fit_plane(const std::vector<Eigen::Vector3d>& points);
 
 // The plane of LiDAR points whose noise is along their rays from the sensor's origin: Gauss-Newton
 // on the range each point would need to lie on the plane, (d - n.x) / (n.x/|x|), from the

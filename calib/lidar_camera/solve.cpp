@@ -12,10 +12,6 @@ namespace {
 
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 
-SE3 perturbed(const SE3& T, const Vec6& d) {
-  return SE3{rotation_from_vector(d.head<3>()) * T.R, T.t + d.tail<3>()};
-}
-
 // The residual of one pair at T (camera plane's tangent angles and distance) and its covariance.
 Eigen::Vector3d residual(const BoardPair& p, const SE3& T) {
   const Eigen::Vector3d n = T.R * p.lidar.n;
@@ -90,11 +86,8 @@ Solution solve(const std::vector<BoardPair>& pairs, double huber) {
   // Closed form.
   Eigen::Matrix3d Hm = Eigen::Matrix3d::Zero();
   for (const BoardPair& p : pairs) Hm += p.camera.n * p.lidar.n.transpose();
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(Hm, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
-  D(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1.0 : 1.0;
   SE3 T;
-  T.R = svd.matrixU() * D * svd.matrixV().transpose();
+  T.R = nearest_rotation(Hm);  // Kabsch
   Eigen::MatrixXd A(pairs.size(), 3);
   Eigen::VectorXd b(pairs.size());
   for (size_t k = 0; k < pairs.size(); ++k) {

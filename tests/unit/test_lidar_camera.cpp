@@ -103,10 +103,7 @@ TEST(LidarCameraReal, AcfrBoardFoundInEveryScanAndSourceCompared) {
   ASSERT_EQ(rows, 50);
   mean /= rows;
   SE3 T_lidar_camera_src;
-  T_lidar_camera_src.R = (Eigen::AngleAxisd(mean[2], Eigen::Vector3d::UnitZ()) *
-                          Eigen::AngleAxisd(mean[1], Eigen::Vector3d::UnitY()) *
-                          Eigen::AngleAxisd(mean[0], Eigen::Vector3d::UnitX()))
-                             .toRotationMatrix();
+  T_lidar_camera_src.R = from_roll_pitch_yaw(mean[0], mean[1], mean[2]);
   T_lidar_camera_src.t = mean.tail<3>();
   const SE3 ours = c.solution.T_camera_lidar.inverse();
   const double drot = rotation_angle(ours.R * T_lidar_camera_src.R.transpose()) * 180 / M_PI;
