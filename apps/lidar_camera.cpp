@@ -25,6 +25,7 @@ struct Options {
   std::string target, camera = "cam_r", lidar = "lidar", session, images, scans, rig, out, report,
                       roi, board_size;
   double corner_sigma_px = 0.1;
+  double max_dt_s = 0.05;
 };
 
 // "a,b,c,d,e,f" -> numbers, named in errors by `what`.
@@ -45,30 +46,58 @@ void run(const Options& o) {
     throw Error(fmt::format("--lidar {}: no such sensor in {}", o.lidar, o.rig));
   const rig::CameraModel cam = cam_sensor->camera;
   const camera::Target target = io::read_target_file(o.target);
-  // The pairs: --session's folders, or the two globs, matched by the frame number in the names.
-  std::string images = o.images, scans = o.scans;
+  // The pairs: a session's camera and ouster_points folders paired by stamp (on the base clock,
+  // within --max-dt), or the two globs paired by the frame number in the names.
+  std::vector<std::string> image_files, scan_files;
   if (!o.session.empty()) {
+    if (!o.images.empty() || !o.scans.empty())
+      throw Error("give --session DIR, or --images GLOB and --scans GLOB, not both");
     // The session layout (doc/session.md): cam_l's images in camera_left, others' in
     // camera_right.
-    images = o.session + "/lidar_camera/" + (o.camera == "cam_l" ? "camera_left" : "camera_right") +
-             "/data/*.png";
-    scans = o.session + "/lidar_camera/ouster_points/data/*.bin";
-  }
-  if (images.empty() || scans.empty())
-    throw Error("give --session DIR, or --images GLOB and --scans GLOB");
-  const std::vector<std::string> image_glob = io::glob_files(images), scan_glob = io::glob_files(scans);
-  if (image_glob.empty()) throw Error(fmt::format("no images match {}", images));
-  if (scan_glob.empty()) throw Error(fmt::format("no scans match {}", scans));
-  // Paired by the frame number in the names; an image or a scan without its partner is an error.
-  const io::ImageSet set = io::pair_by_frame_number({{"images", image_glob}, {"scans", scan_glob}});
-  std::vector<std::string> image_files, scan_files;
-  for (size_t k = 0; k < set.files[0].size(); ++k) {
-    const std::string &img = set.files[0][k], &scan = set.files[1][k];
-    if (img.empty() || scan.empty()) {
-      throw Error(fmt::format("{} has no {} with the same frame number", img.empty() ? scan : img,
-                              img.empty() ? "image" : "scan"));
+    const std::filesystem::path dir = std::filesystem::path(o.session) / "lidar_camera";
+    const io::StampedFolder images = io::read_stamped_folder(
+        dir / (o.camera == "cam_l" ? "camera_left" : "camera_right"), ".png");
+    const io::StampedFolder scans = io::read_stamped_folder(dir / "ouster_points", ".bin");
+    if (images.files.empty()) throw Error(fmt::format("{}: no images", dir.string()));
+    if (scans.files.empty()) throw Error(fmt::format("{}: no scans", dir.string()));
+    auto on_base_clock = [&](std::vector<Time> t, const std::string& sensor) {
+      const Time offset = Time::from_seconds(rig::sensor(rig, sensor).time_offset);
+      for (Time& x : t) x = x + offset;
+      return t;
+    };
+    const std::vector<std::optional<size_t>> scan_of =
+        io::pair_by_stamp(on_base_clock(images.stamps, o.camera),
+                          on_base_clock(scans.stamps, o.lidar), Time::from_seconds(o.max_dt_s));
+    for (size_t k = 0; k < scan_of.size(); ++k) {
+      if (!scan_of[k]) {
+        fmt::print("{}: no scan within {} s, skipped\n", images.files[k], o.max_dt_s);
+        continue;
+      }
+      image_files.push_back(images.files[k]), scan_files.push_back(scans.files[*scan_of[k]]);
     }
-    image_files.push_back(img), scan_files.push_back(scan);
+    if (image_files.empty()) {
+      throw Error(
+          fmt::format("{}: no image has a scan within {} s (--max-dt)", dir.string(), o.max_dt_s));
+    }
+  } else {
+    if (o.images.empty() || o.scans.empty())
+      throw Error("give --session DIR, or --images GLOB and --scans GLOB");
+    const std::vector<std::string> image_glob = io::glob_files(o.images),
+                                   scan_glob = io::glob_files(o.scans);
+    if (image_glob.empty()) throw Error(fmt::format("no images match {}", o.images));
+    if (scan_glob.empty()) throw Error(fmt::format("no scans match {}", o.scans));
+    // Paired by the frame number in the names; an image or a scan without its partner is an
+    // error.
+    const io::ImageSet set =
+        io::pair_by_frame_number({{"images", image_glob}, {"scans", scan_glob}});
+    for (size_t k = 0; k < set.files[0].size(); ++k) {
+      const std::string &img = set.files[0][k], &scan = set.files[1][k];
+      if (img.empty() || scan.empty()) {
+        throw Error(fmt::format("{} has no {} with the same frame number", img.empty() ? scan : img,
+                                img.empty() ? "image" : "scan"));
+      }
+      image_files.push_back(img), scan_files.push_back(scan);
+    }
   }
   const camera::Outline outline = camera::outline(target);
   lidar_camera::BoardSearch search;
@@ -166,9 +195,14 @@ void add_lidar_camera(CLI::App& app) {
   cmd->add_option("--rig", o->rig, "rig with the camera's intrinsics; updated with --out")
       ->required();
   cmd->add_option("--session", o->session,
-                  "session folder: lidar_camera/camera_right (camera_left for cam_l)/data/*.png + "
-                  "ouster_points/data/*.bin");
-  cmd->add_option("--images", o->images, "image glob; pairs are matched by the last number in the file names");
+                  "session folder: lidar_camera/camera_right (camera_left for cam_l) and "
+                  "lidar_camera/ouster_points, each data/ + timestamps.txt; pairs by stamp on the "
+                  "base clock (the rig's time offsets applied)");
+  cmd->add_option("--max-dt", o->max_dt_s,
+                  "--session: an image takes the nearest scan within this many seconds")
+      ->capture_default_str();
+  cmd->add_option("--images", o->images,
+                  "image glob; pairs are matched by the last number in the file names");
   cmd->add_option("--scans", o->scans, "scan glob");
   cmd->add_option("--out", o->out, "output calibration YAML");
   cmd->add_option("--report", o->report, "report folder: lidar_camera.json, pair_NN.png");

@@ -67,37 +67,58 @@ ImageSet pair_by_frame_number(
   return in;
 }
 
+StampedFolder read_stamped_folder(const fs::path& folder, const std::string& extension) {
+  StampedFolder out;
+  out.files = glob_files((folder / "data" / ("*" + extension)).string());
+  const fs::path stamps = folder / "timestamps.txt";
+  const std::string text = read_text_file(stamps);
+  size_t pos = 0;
+  int line = 0;
+  while (pos < text.size()) {
+    const size_t end = std::min(text.find('\n', pos), text.size());
+    ++line;
+    const std::string_view s = trim(std::string_view(text).substr(pos, end - pos));
+    if (!s.empty()) {
+      try {
+        out.stamps.push_back(parse_time(s));
+      } catch (const Error&) {
+        fail_at(stamps.string(), line, "", fmt::format("expected a time, got '{}'", s));
+      }
+    }
+    pos = end + 1;
+  }
+  if (out.stamps.size() != out.files.size()) {
+    throw Error(fmt::format("{}: {} stamps in timestamps.txt for {} {} files in data/",
+                            folder.string(), out.stamps.size(), out.files.size(), extension));
+  }
+  return out;
+}
+
+std::vector<std::optional<size_t>> pair_by_stamp(const std::vector<Time>& a,
+                                                 const std::vector<Time>& b, Time tolerance) {
+  std::vector<std::optional<size_t>> out(a.size());
+  std::vector<char> used(b.size(), 0);
+  for (size_t i = 0; i < a.size(); ++i) {
+    size_t best = 0;
+    int64_t best_d = INT64_MAX;
+    for (size_t j = 0; j < b.size(); ++j) {
+      const int64_t d = std::abs((b[j] - a[i]).ns);
+      if (d < best_d) best_d = d, best = j;
+    }
+    if (best_d <= tolerance.ns && !used[best]) {
+      used[best] = 1;
+      out[i] = best;
+    }
+  }
+  return out;
+}
+
 ImageSet read_session_images(const fs::path& dir) {
-  std::vector<std::pair<std::string, std::vector<std::string>>> cams;
-  std::vector<std::vector<Time>> stamps;
+  std::vector<std::pair<std::string, StampedFolder>> cams;
   for (const auto& [folder, name] :
        {std::pair{"camera_left", "cam_l"}, std::pair{"camera_right", "cam_r"}}) {
-    if (!fs::exists(dir / folder)) continue;
-    std::vector<std::string> files = glob_files((dir / folder / "data" / "*.png").string());
-    std::vector<Time> t;
-    const std::string text = read_text_file(dir / folder / "timestamps.txt");
-    size_t pos = 0;
-    int line = 0;
-    while (pos < text.size()) {
-      const size_t end = std::min(text.find('\n', pos), text.size());
-      ++line;
-      const std::string_view s = trim(std::string_view(text).substr(pos, end - pos));
-      if (!s.empty()) {
-        try {
-          t.push_back(parse_time(s));
-        } catch (const Error&) {
-          fail_at((dir / folder / "timestamps.txt").string(), line, "",
-                  fmt::format("expected a time, got '{}'", s));
-        }
-      }
-      pos = end + 1;
-    }
-    if (t.size() != files.size()) {
-      throw Error(fmt::format("{}: {} stamps for {} images", (dir / folder).string(), t.size(),
-                              files.size()));
-    }
-    cams.emplace_back(name, files);
-    stamps.push_back(t);
+    if (fs::exists(dir / folder))
+      cams.emplace_back(name, read_stamped_folder(dir / folder, ".png"));
   }
   if (cams.empty())
     throw Error(fmt::format("{}: no camera_left or camera_right folder", dir.string()));
@@ -105,25 +126,15 @@ ImageSet read_session_images(const fs::path& dir) {
   for (const auto& c : cams) in.names.push_back(c.first);
   in.files.assign(cams.size(), {});
   if (cams.size() == 1) {
-    in.files[0] = cams[0].second;
+    in.files[0] = cams[0].second.files;
     return in;
   }
   // Pair by stamp: the nearest right image within 5 ms of each left one.
-  std::vector<char> used(cams[1].second.size(), 0);
-  for (size_t i = 0; i < cams[0].second.size(); ++i) {
-    size_t best = 0;
-    int64_t best_d = INT64_MAX;
-    for (size_t j = 0; j < stamps[1].size(); ++j) {
-      const int64_t d = std::abs((stamps[1][j] - stamps[0][i]).ns);
-      if (d < best_d) best_d = d, best = j;
-    }
-    in.files[0].push_back(cams[0].second[i]);
-    if (best_d <= 5'000'000 && !used[best]) {
-      used[best] = 1;
-      in.files[1].push_back(cams[1].second[best]);
-    } else {
-      in.files[1].push_back("");
-    }
+  const std::vector<std::optional<size_t>> right =
+      pair_by_stamp(cams[0].second.stamps, cams[1].second.stamps, Time::from_ns(5'000'000));
+  for (size_t i = 0; i < right.size(); ++i) {
+    in.files[0].push_back(cams[0].second.files[i]);
+    in.files[1].push_back(right[i] ? cams[1].second.files[*right[i]] : "");
   }
   return in;
 }

@@ -8,6 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include "rigcal/core/time.h"
+
 namespace rigcal::io {
 
 struct ImageSet {
@@ -24,6 +26,18 @@ std::optional<long> frame_number(const std::string& path);
 // in one camera.
 ImageSet pair_by_frame_number(
     const std::vector<std::pair<std::string, std::vector<std::string>>>& cameras);
+// A session folder in the vbr-devkit layout: data/*<extension> (sorted) and timestamps.txt, one
+// stamp a line (ISO-8601 or seconds) for each file. Throws rigcal::Error when the counts differ.
+struct StampedFolder {
+  std::vector<std::string> files;
+  std::vector<Time> stamps;
+};
+StampedFolder read_stamped_folder(const std::filesystem::path& folder,
+                                  const std::string& extension);
+// For each stamp of `a`, the nearest stamp of `b` within `tolerance`, each of `b` taken once
+// (first come); nullopt where none.
+std::vector<std::optional<size_t>> pair_by_stamp(const std::vector<Time>& a,
+                                                 const std::vector<Time>& b, Time tolerance);
 // camera_left/ (cam_l) and camera_right/ (cam_r) of a session, paired by stamp within 5 ms.
 ImageSet read_session_images(const std::filesystem::path& session);
 

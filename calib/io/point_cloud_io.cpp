@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 
@@ -20,15 +21,158 @@ void keep(std::vector<Eigen::Vector3d>& out, double x, double y, double z) {
   out.emplace_back(x, y, z);
 }
 
+// A field of a ROS PointCloud2 as vbr-devkit's .metadata.json lists it.
+struct Field {
+  std::string name;
+  size_t offset = 0;
+  int datatype = 0;  // sensor_msgs/PointField: 1 int8 .. 6 uint32, 7 float32, 8 float64
+  size_t count = 1;
+};
+
+size_t datatype_size(int t) {
+  static constexpr size_t sizes[] = {0, 1, 1, 2, 2, 4, 4, 4, 8};
+  return t >= 1 && t <= 8 ? sizes[t] : 0;
+}
+
+double field_value(const char* record, const Field& f) {
+  const char* p = record + f.offset;
+  switch (f.datatype) {
+    case 1:
+      return static_cast<double>(*reinterpret_cast<const int8_t*>(p));
+    case 2:
+      return static_cast<double>(*reinterpret_cast<const uint8_t*>(p));
+    case 3: {
+      int16_t v;
+      std::memcpy(&v, p, 2);
+      return v;
+    }
+    case 4: {
+      uint16_t v;
+      std::memcpy(&v, p, 2);
+      return v;
+    }
+    case 5: {
+      int32_t v;
+      std::memcpy(&v, p, 4);
+      return v;
+    }
+    case 6: {
+      uint32_t v;
+      std::memcpy(&v, p, 4);
+      return v;
+    }
+    case 7: {
+      float v;
+      std::memcpy(&v, p, 4);
+      return v;
+    }
+    default: {
+      double v;
+      std::memcpy(&v, p, 8);
+      return v;
+    }
+  }
+}
+
+// vbr-devkit writes a topic's fields in <topic>/.metadata.json beside data/; with
+// --no-reduce-pcloud each point is the driver's whole record (point_step bytes), otherwise the
+// four float32 x, y, z, intensity. Empty when there is no such file.
+std::vector<Field> vbr_fields(const std::filesystem::path& bin, size_t& point_step) {
+  const std::filesystem::path meta = bin.parent_path().parent_path() / ".metadata.json";
+  if (!std::filesystem::exists(meta)) return {};
+  std::ifstream in(meta);
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const std::exception& e) {
+    throw Error(fmt::format("{}: not JSON ({})", meta.string(), e.what()));
+  }
+  if (!j.contains("fields")) return {};
+  std::vector<Field> fields;
+  size_t extent = 0;
+  try {
+    for (const auto& f : j.at("fields")) {
+      Field x{f.at("name").get<std::string>(), f.at("offset").get<size_t>(),
+              f.at("datatype").get<int>(), f.value("count", size_t{1})};
+      if (datatype_size(x.datatype) == 0)
+        throw Error(fmt::format("field '{}': datatype {} unknown", x.name, x.datatype));
+      extent = std::max(extent, x.offset + datatype_size(x.datatype) * x.count);
+      fields.push_back(x);
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(fmt::format("{}: fields not read ({})", meta.string(), e.what()));
+  } catch (const Error& e) {
+    throw Error(fmt::format("{}: {}", meta.string(), e.what()));
+  }
+  // The record's size: "point_step" where given, else the fields' extent padded to 16 bytes
+  // (the Ouster driver's and PCL's aligned point types: 48 bytes for x..range).
+  point_step = j.contains("point_step") ? j["point_step"].get<size_t>() : (extent + 15) / 16 * 16;
+  return fields;
+}
+
 std::vector<Eigen::Vector3d> read_kitti_bin(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(fmt::format("{}: cannot open", path.string()));
   const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (data.size() % 16 != 0) {
-    throw Error(fmt::format("{}: {} bytes is not a whole number of KITTI points (4 float32 each)",
-                            path.string(), data.size()));
+  size_t step = 16;
+  const std::vector<Field> fields = vbr_fields(path, step);
+  auto find = [&](const char* name) -> const Field* {
+    for (const Field& f : fields)
+      if (f.name == name) return &f;
+    return nullptr;
+  };
+  const Field *fx = find("x"), *fy = find("y"), *fz = find("z"), *ring = find("ring");
+  // Full records? Both layouts may divide the file's size; the wrong one shows itself: KITTI
+  // records read from full ones hold the driver's integer fields as tiny non-zero floats, full
+  // records read from KITTI ones have rings in the tens of thousands.
+  bool full = false;
+  if (!fields.empty() && step != 16 && data.size() % step == 0) {
+    if (!fx || !fy || !fz)
+      throw Error(fmt::format("{}: the metadata's fields lack x, y or z", path.string()));
+    size_t tiny = 0, records = data.size() / 16;
+    for (size_t k = 0; k + 16 <= data.size(); k += 16) {
+      float v[3];
+      std::memcpy(v, data.data() + k, 12);
+      bool all_tiny = v[0] != 0 || v[1] != 0 || v[2] != 0;
+      for (float x : v) all_tiny = all_tiny && std::abs(x) < 1e-20f;
+      tiny += all_tiny;
+    }
+    const bool kitti_plausible = data.size() % 16 == 0 && tiny * 20 < records;
+    bool rings_plausible = true;
+    if (ring) {
+      for (size_t k = 0; k < data.size(); k += step)
+        rings_plausible = rings_plausible && field_value(data.data() + k, *ring) < 1024;
+    }
+    if (rings_plausible && !kitti_plausible) {
+      full = true;
+    } else if (rings_plausible && kitti_plausible) {
+      throw Error(fmt::format(
+          "{}: {} bytes fit both {}-byte full records ({}) and 16-byte KITTI points; convert "
+          "with vbr-devkit's default (reduced) layout",
+          path.string(), data.size(), step, "the metadata's fields"));
+    } else if (!kitti_plausible) {
+      throw Error(fmt::format(
+          "{}: neither {}-byte records of the metadata's fields (rings >= 1024) nor KITTI points "
+          "(tiny non-zero coordinates); is .metadata.json this topic's?",
+          path.string(), step));
+    }
   }
   std::vector<Eigen::Vector3d> out;
+  if (full) {
+    out.reserve(data.size() / step);
+    for (size_t k = 0; k < data.size(); k += step) {
+      const char* r = data.data() + k;
+      keep(out, field_value(r, *fx), field_value(r, *fy), field_value(r, *fz));
+    }
+    return out;
+  }
+  if (data.size() % 16 != 0) {
+    throw Error(fmt::format(
+        "{}: {} bytes is not a whole number of KITTI points (4 float32 each){}", path.string(),
+        data.size(),
+        fields.empty() ? ""
+                       : fmt::format(" nor of {}-byte records of the metadata's fields", step)));
+  }
   out.reserve(data.size() / 16);
   for (size_t k = 0; k < data.size(); k += 16) {
     float v[4];

@@ -1,5 +1,7 @@
 #pragma once
-// Point clouds (doc/formats.md): KITTI-style .bin (float32 x, y, z, intensity per point) and PCD
+// Point clouds (doc/formats.md): KITTI-style .bin (float32 x, y, z, intensity per point);
+// vbr-devkit's full-field .bin (the driver's whole point record, described by the fields in the
+// topic's .metadata.json beside data/; told from the reduced layout by content, not size); PCD
 // v0.7 (DATA ascii or binary; fields x, y, z required, others skipped; binary_compressed is
 // refused with a message). Points with no return, stored as (0, 0, 0) or NaN, are dropped.
 // rigcal reads PCD itself rather than through PCL: the two layouts are a page of code, and PCL's

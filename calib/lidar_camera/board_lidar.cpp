@@ -4,9 +4,12 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <climits>
 #include <cmath>
+#include <map>
 #include <opencv2/imgproc.hpp>
 #include <random>
+#include <tuple>
 #include <unordered_map>
 
 namespace rigcal::lidar_camera {
@@ -147,6 +150,7 @@ struct Candidate {
   cv::Mat region;
   Eigen::Matrix<double, 3, 2> B;
   Eigen::Vector2d lo;
+  Eigen::Vector2d long_side;  // unit, in the (u, v) of B: along the rectangle's long side
   double cell = 0.02;
   bool contains(const Eigen::Vector3d& x) const {
     const Eigen::Vector2d q = (B.transpose() * x - lo) / cell;
@@ -213,10 +217,50 @@ std::vector<Candidate> board_shaped(const std::vector<Eigen::Vector3d>& all,
     if (c.w < W - s.short_m || c.w > W + s.long_m || c.h < H - s.short_m || c.h > H + s.long_m)
       continue;
     cv::dilate(labels == l, c.region, cv::Mat::ones(3, 3, CV_8U));
+    cv::Point2f v[4];
+    rect.points(v);
+    const Eigen::Vector2d e1(v[1].x - v[0].x, v[1].y - v[0].y),
+        e2(v[2].x - v[1].x, v[2].y - v[1].y);
+    c.long_side = (e1.norm() >= e2.norm() ? e1 : e2).normalized();
     c.B = B;
     c.lo = lo;
     c.cell = cell;
     out.push_back(std::move(c));
+  }
+  return out;
+}
+
+// The points without stubs that the raster kept at the board's edges (a stand's post just below
+// the board, an arm holding it): along each side of the board's rectangle, 1 cm strips across it
+// whose points span less than half the board are dropped from both ends (a board's strip spans
+// the board, a post's its own few centimetres). Strips inside the board are kept whatever their
+// span (sparse rings).
+std::vector<Eigen::Vector3d> without_stubs(const std::vector<Eigen::Vector3d>& pts,
+                                           const Candidate& c, double W, double H) {
+  const Eigen::Vector2d a = c.long_side, b(-a.y(), a.x());
+  std::vector<Eigen::Vector3d> out = pts;
+  for (const auto& [along, across, size_across] : {std::tuple{a, b, H}, std::tuple{b, a, W}}) {
+    const double strip = 0.01;
+    std::map<int, std::pair<double, double>> span;  // strip -> min, max across
+    auto strip_of = [&](const Eigen::Vector3d& x) {
+      return static_cast<int>(std::floor(along.dot(c.B.transpose() * x) / strip));
+    };
+    for (const Eigen::Vector3d& x : out) {
+      const double t = across.dot(c.B.transpose() * x);
+      auto [it, fresh] = span.try_emplace(strip_of(x), t, t);
+      if (!fresh) it->second = {std::min(it->second.first, t), std::max(it->second.second, t)};
+    }
+    int first = INT_MAX, last = INT_MIN;
+    for (const auto& [k, mm] : span) {
+      if (mm.second - mm.first >= 0.5 * size_across) first = std::min(first, k), last = k;
+    }
+    if (first > last) continue;  // no strip spans half the board: leave the points alone
+    std::vector<Eigen::Vector3d> kept;
+    for (const Eigen::Vector3d& x : out) {
+      const int k = strip_of(x);
+      if (k >= first && k <= last) kept.push_back(x);
+    }
+    out.swap(kept);
   }
   return out;
 }
@@ -361,6 +405,7 @@ LidarBoard find_board(const std::vector<Eigen::Vector3d>& all, const BoardSearch
   for (const Eigen::Vector3d& x : all) {
     if (std::abs(range_residual(p0.n, p0.d, x)) <= tol && best->contains(x)) near.push_back(x);
   }
+  near = without_stubs(near, *best, W, H);
   for (int it = 0; it < 5 && near.size() >= static_cast<size_t>(s.min_points); ++it) {
     p0 = fit_plane_along_rays(near, &rms);
     std::vector<Eigen::Vector3d> kept;

@@ -43,21 +43,33 @@ void add_board(Scene& scene, const camera::Target& target, const camera::Pattern
   T_box.t = T_world_board * Eigen::Vector3d(c.x(), c.y(), 0.5 * th + 1e-5);
   add_box(scene, T_box, Eigen::Vector3d(0.5 * o.width(), 0.5 * o.height(), 0.5 * th), 0.5, id);
   scene.rects.push_back(front);  // last: wins ties with the box's front face
-  // A stand: a thin post from the board's lowest point down to the floor, behind the board.
-  double lowest = 1e9;
-  Eigen::Vector3d low_point;
-  for (double x : {o.x_min, o.x_max}) {
-    for (double y : {o.y_min, o.y_max}) {
-      const Eigen::Vector3d p = T_world_board * Eigen::Vector3d(x, y, th);
-      if (p.z() < lowest) lowest = p.z(), low_point = p;
-    }
-  }
+  // A stand: a thin vertical post (4 x 4 cm) from the floor up behind the board's centre. Its top
+  // is lowered until no part of it is inside the board's slab (a tilted board would otherwise be
+  // pierced by it, and post points would lie on or in front of the printed face).
+  const SE3 T_board_world = T_world_board.inverse();
   const Eigen::Vector3d centre_back = T_world_board * Eigen::Vector3d(c.x(), c.y(), th + 0.03);
-  const double height = centre_back.z() - z_floor;
+  const double half = 0.02;
+  auto pierces = [&](double top) {
+    for (double z = z_floor; z <= top + 1e-9; z += 0.005) {
+      for (double dx = -half; dx <= half + 1e-9; dx += 0.01) {
+        for (double dy = -half; dy <= half + 1e-9; dy += 0.01) {
+          const Eigen::Vector3d q =
+              T_board_world * Eigen::Vector3d(centre_back.x() + dx, centre_back.y() + dy, z);
+          if (q.z() < th + 0.002 && q.z() > -0.05 && q.x() > o.x_min - 0.01 &&
+              q.x() < o.x_max + 0.01 && q.y() > o.y_min - 0.01 && q.y() < o.y_max + 0.01)
+            return true;
+        }
+      }
+    }
+    return false;
+  };
+  double top = centre_back.z();
+  while (top - z_floor > 0.05 && pierces(top)) top -= 0.01;
+  const double height = top - z_floor;
   if (height > 0.05) {
     SE3 T_post;
     T_post.t = Eigen::Vector3d(centre_back.x(), centre_back.y(), z_floor + 0.5 * height);
-    add_box(scene, T_post, Eigen::Vector3d(0.02, 0.02, 0.5 * height), 0.4, 0);
+    add_box(scene, T_post, Eigen::Vector3d(half, half, 0.5 * height), 0.4, 0);
   }
 }
 

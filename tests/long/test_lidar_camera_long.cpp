@@ -1,8 +1,9 @@
 // Issue 8, acceptance 1 over seeds: 10 simulated pairs (OS0-128 noise, clutter) per seed, 20
 // seeds: how often the bars (rotation <= 0.1 deg, translation <= 5 mm) are met (printed: the
-// rotation bar is not met reliably, see doc/lidar-camera.md), whether the board is found in every
-// scan, and whether the errors fall within 3 reported sigmas at least 95 % of the time. The short
-// version is LidarCameraSim.* in make test.
+// rotation's 1-sigma about the optical axis is 0.05-0.11 deg with 10 boards, so 0.1 deg is not met
+// on every seed, see doc/lidar-camera.md), whether the board is found in every scan, and whether
+// the errors fall within 3 reported sigmas at least 95 % of the time. The short version is
+// LidarCameraSim.* in make test.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -41,14 +42,12 @@ TEST(LidarCameraSimLong, TwentySeeds) {
       "boards found in %d of %d scans; rotation <= 0.1 deg in %d of %d, translation <= 5 mm in "
       "%d of %d; within 3 sigma: rotation %d of %d axes, translation %d of %d\n",
       found, pairs, rot_ok, runs, trans_ok, runs, cover_r, 3 * runs, cover_t, 3 * runs);
-  // Asserted: the board found in every scan (the simulator's boards are fully visible) and the
-  // translation sigmas honest. The rotation's coverage is printed, not asserted: with the
-  // systematic ~0.07 deg left about the camera's x axis it is 93-95 % (56-57 of 60), at or just
-  // under the issue's 95 % (doc/lidar-camera.md, "Not met").
+  // Asserted: the board found in every scan (the simulator's boards are fully visible), the
+  // translation and rotation sigmas honest, every translation within 5 mm.
   EXPECT_EQ(found, pairs);
+  EXPECT_EQ(trans_ok, runs);
   EXPECT_GE(cover_t, 0.95 * 3 * runs);
-  std::printf("rotation coverage %.1f %% (the issue asks >= 95 %%)\n",
-              100.0 * cover_r / (3 * runs));
+  EXPECT_GE(cover_r, 0.95 * 3 * runs);
 }
 
 }  // namespace

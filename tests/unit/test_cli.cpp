@@ -600,6 +600,16 @@ TEST_F(Cli, LidarCameraWritesTheRigAndRefusesTooFewBoards) {
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("has no image with the same frame number"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out2));
+  // --session pairs by stamp on the base clock: with cam_r's clock 5 s off in the rig, no image
+  // has a scan within --max-dt (the simulator's pairs are 10 s apart).
+  rig::Rig shifted = rig::read_rig_file(kSample);
+  rig::sensor(shifted, "cam_r").time_offset = 5.0;
+  const fs::path shifted_rig = write("shifted.yaml", rig::rig_to_yaml(shifted));
+  r = run("lidar-camera --target " + target + " --rig " + shifted_rig.string() + " --session " +
+          sim.string() + " --out " + out2);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("no image has a scan within 0.05 s"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out2));
 }
 
 TEST_F(Cli, HandEyeWritesTheExtrinsicAndRefusesAnUndeterminedDirection) {

@@ -6,8 +6,10 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <tuple>
 
 #include "fixtures.h"
 #include "lidar_camera_sim.h"
@@ -27,11 +29,10 @@ double rotation_error_deg(const SE3& a, const SE3& b) {
   return rotation_angle(a.R * b.R.transpose()) * 180.0 / M_PI;
 }
 
-// Acceptance 2 and part of 1 (seed 1): 10 pairs with a person-sized box next to the board: the
-// board is found in every scan; translation <= 5 mm and within 3 reported sigmas. The rotation
-// bar (0.1 deg) is not met reliably: over 20 seeds (make test-long) the error is 0.03-0.28 deg
-// with a systematic part of about +0.07 deg about the camera's x axis whose cause is not found
-// yet (doc/lidar-camera.md); here it is held to 0.1 deg on this seed (0.037 deg measured).
+// Acceptance 2 and 1 on seed 1: 10 pairs with a person-sized box next to the board: the board is
+// found in every scan; rotation <= 0.1 deg (0.044 measured), translation <= 5 mm, both within 3
+// reported sigmas. Over 20 seeds (make test-long) the rotation is <= 0.1 deg in 14 of 20: its
+// 1-sigma about the camera's optical axis is 0.05-0.11 deg with 10 boards (doc/lidar-camera.md).
 TEST(LidarCameraSim, TenPairsWithClutter) {
   const testing::SimRun r = testing::simulate_and_solve(1);
   const Solution& s = r.solution;
@@ -54,6 +55,50 @@ TEST(LidarCameraSim, TenPairsWithClutter) {
   EXPECT_LE(rot, 0.1);
   EXPECT_LE(e.norm(), 0.005);
   for (int i = 0; i < 3; ++i) EXPECT_LE(std::abs(e[i]), 3 * s.translation_sigma_m[i]) << i;
+  const Eigen::Vector3d dr = rotation_vector(s.T_camera_lidar.R * r.truth.R.transpose());
+  for (int i = 0; i < 3; ++i)
+    EXPECT_LE(std::abs(dr[i]) * 180 / M_PI, 3 * s.rotation_sigma_deg[i]) << i;
+}
+
+// The board's points are the board's: the stand's post just below the board (1-2 cm behind its
+// plane, within the range noise) is not taken with it. The simulator knows which object each
+// point hit; a post kept at the board's lower edge tilted the plane by ~0.1 deg (about the camera's
+// x axis, in most seeds) before the strips spanning less than half the board were dropped.
+TEST(LidarCameraSim, StandPostIsNotTakenAsBoard) {
+  const rig::Rig rig = rig::read_rig_file(RIGCAL_SOURCE_DIR "/data/sample_rig.yaml");
+  sim::SimConfig cfg;
+  cfg.seed = 1;
+  cfg.lidar_camera_pairs = 6;
+  const sim::LidarCameraPart part = sim::simulate_lidar_camera(rig, cfg);
+  const camera::Outline outline = camera::outline(cfg.target);
+  int stand_points = 0, board_points = 0, pairs_with_stand_points = 0;
+  for (size_t k = 0; k < part.scans.size(); ++k) {
+    std::vector<Eigen::Vector3d> scan;
+    std::map<std::tuple<float, float, float>, int> object;
+    for (const sim::LidarPoint& p : part.scans[k]) {
+      scan.push_back(p.p.cast<double>());
+      object[{p.p.x(), p.p.y(), p.p.z()}] = p.object;
+    }
+    BoardSearch s;
+    s.board_width_m = outline.width();
+    s.board_height_m = outline.height();
+    s.seed = k;
+    const LidarBoard b = find_board(scan, s);
+    ASSERT_TRUE(b.found) << k << ": " << b.reason;
+    int stand = 0;
+    for (const Eigen::Vector3d& x : b.points) {
+      const Eigen::Vector3f f = x.cast<float>();
+      stand += object.at({f.x(), f.y(), f.z()}) != 1;
+    }
+    std::printf("pair %zu: %zu board points, %d of them not on the board\n", k, b.points.size(),
+                stand);
+    stand_points += stand;
+    board_points += static_cast<int>(b.points.size());
+    pairs_with_stand_points += stand > 2;
+  }
+  // A few mixed returns at the post's junction may remain; whole rings across the post may not.
+  EXPECT_LE(stand_points, board_points / 500);
+  EXPECT_EQ(pairs_with_stand_points, 0);
 }
 
 // Acceptance 3, real data: ACFR's 11 pairs (Ouster 64-beam full scans, 1920 x 1208 fisheye images,
