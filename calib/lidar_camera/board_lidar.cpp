@@ -265,6 +265,25 @@ std::vector<Eigen::Vector3d> without_stubs(const std::vector<Eigen::Vector3d>& p
   return out;
 }
 
+// Points are dropped beyond kTrim times the RMS of the points kept (until nothing changes).
+constexpr double kTrim = 2.5;
+
+// The covariance of a least-squares fit on Gaussian residuals trimmed at k times their own RMS,
+// over the formula's (residual variance of the kept points times (J^T J)^-1). The trimming stops
+// where c = k sqrt((P - 2 c phi(c)) / P), c the cut in true sigmas, P = P(|x| < c); the trimmed
+// (skipped) estimator's variance is then sigma^2 / (P - 2 c phi(c)) per kept point's share, the
+// formula's (P - 2 c phi(c)) / P sigma^2: the ratio is P^2 / (P - 2 c phi(c))^2, 1.29 for k = 2.5
+// (sigmas 14 % larger; 20 simulated seeds: the LiDAR planes' errors were 1.14-1.22 of their sigmas
+// before).
+double trimmed_covariance_factor(double k) {
+  auto phi = [](double x) { return std::exp(-0.5 * x * x) / std::sqrt(2 * M_PI); };
+  auto P = [](double x) { return std::erf(x / std::sqrt(2.0)); };
+  double c = k;
+  for (int i = 0; i < 50; ++i) c = k * std::sqrt((P(c) - 2 * c * phi(c)) / P(c));
+  const double a = P(c) - 2 * c * phi(c);
+  return P(c) * P(c) / (a * a);
+}
+
 }  // namespace
 
 LidarBoard find_board(const std::vector<Eigen::Vector3d>& all, const BoardSearch& s) {
@@ -410,7 +429,7 @@ LidarBoard find_board(const std::vector<Eigen::Vector3d>& all, const BoardSearch
     p0 = fit_plane_along_rays(near, &rms);
     std::vector<Eigen::Vector3d> kept;
     for (const Eigen::Vector3d& x : near) {
-      if (std::abs(range_residual(p0.n, p0.d, x)) <= 2.5 * rms) kept.push_back(x);
+      if (std::abs(range_residual(p0.n, p0.d, x)) <= kTrim * rms) kept.push_back(x);
     }
     const bool same = kept.size() == near.size();
     near.swap(kept);
@@ -418,6 +437,7 @@ LidarBoard find_board(const std::vector<Eigen::Vector3d>& all, const BoardSearch
   }
   out.points = near;
   out.plane = fit_plane_along_rays(out.points, &out.plane_rms_m);
+  out.plane.covariance *= trimmed_covariance_factor(kTrim);
   out.centre = best->centre;
   out.width_m = best->w;
   out.height_m = best->h;
