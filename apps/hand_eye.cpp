@@ -25,7 +25,7 @@ struct Options {
   std::string duplicates = "error", attitude;
   std::vector<std::string> fix;  // AXIS=VALUE, GNSS/INS frame
   double spacing_s = 1.0, stride_s = 0.1, min_rotation_deg = 1.0, rotation_sigma_deg = 0.05,
-         translation_sigma_m = 0.02, max_sigma_m = 0.05;
+         translation_sigma_m = 0.02, max_sigma_m = 0.05, gnss_smoothing_s = 0.05;
   bool estimate_offset = false;
 };
 
@@ -128,6 +128,7 @@ void run(const Options& o) {
   po.stride_s = o.stride_s;
   po.min_rotation_deg = o.min_rotation_deg;
   po.time_offset_s = offset_s;
+  po.gnss_half_window_s = o.gnss_smoothing_s;
   const std::vector<hand_eye::MotionPair> pairs = hand_eye::motion_pairs(lidar, gnss, po);
   if (pairs.size() < 3) {
     throw Error(fmt::format(
@@ -270,6 +271,11 @@ void add_hand_eye(CLI::App& app) {
   cmd->add_option("--stride", o->stride_s,
                   "seconds between the starts of consecutive pairs (0: end to end); overlapping "
                   "pairs are not counted as independent in the covariance")
+      ->capture_default_str();
+  cmd->add_option(
+         "--gnss-smoothing", o->gnss_smoothing_s,
+         "each GNSS/INS pose from a local quadratic fit over the fixes within +- this many "
+         "seconds (at least 5 of them; 0: the fixes as they are)")
       ->capture_default_str();
   cmd->add_option("--min-rotation", o->min_rotation_deg, "pairs rotating less are dropped (deg)")
       ->capture_default_str();

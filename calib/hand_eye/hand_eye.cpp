@@ -268,8 +268,84 @@ Refined refine(const std::vector<MotionPair>& pairs, const SE3& initial, const R
   return solve(pairs, first.T_gnss_lidar, first.odometry_scale, o, rot_noise, trans_noise);
 }
 
-std::vector<MotionPair> motion_pairs(const Trajectory& lidar, const Trajectory& gnss,
+Trajectory smooth_poses(const Trajectory& in, double half_window_s) {
+  Trajectory out = in;
+  if (half_window_s <= 0) return out;
+  const Time h = Time::from_seconds(half_window_s);
+  // The fixes' noise from their second differences (white noise: variance 6 sigma^2), robustly:
+  // fixes beyond 5 sigma (and 5 cm) of a window's fit are left out of it. A window's own misfits
+  // would not do: a 1.5 m jump drags a least-squares quadratic by decimetres at every fix.
+  double noise = 0;
+  if (in.size() >= 3) {
+    for (int a = 0; a < 3; ++a) {
+      std::vector<double> d2;
+      for (size_t k = 1; k + 1 < in.size(); ++k) {
+        d2.push_back(std::abs(in.T_world_body[k + 1].t[a] - 2 * in.T_world_body[k].t[a] +
+                              in.T_world_body[k - 1].t[a]));
+      }
+      std::nth_element(d2.begin(), d2.begin() + d2.size() / 2, d2.end());
+      noise += std::pow(1.4826 * d2[d2.size() / 2] / std::sqrt(6.0), 2);
+    }
+  }
+  const double cut = std::max(0.05, 5.0 * std::sqrt(noise));
+  size_t lo = 0, hi = 0;
+  for (size_t i = 0; i < in.size(); ++i) {
+    while (in.stamps[lo] < in.stamps[i] - h) ++lo;
+    while (hi < in.size() && in.stamps[hi] <= in.stamps[i] + h) ++hi;
+    if (hi - lo < 5) continue;
+    const SE3& Ti = in.T_world_body[i];
+    // Rows 1, dt, dt^2: positions, and rotation vectors relative to the pose's own (a linear fit
+    // would be biased by the angular acceleration: alpha h^2 / 6, 0.1 deg on a hand-held rig).
+    auto fit = [&](const std::vector<char>& use, Eigen::Vector3d& p, Eigen::Vector3d& w,
+                   std::vector<double>* misfit) {
+      Eigen::Matrix3d Ap = Eigen::Matrix3d::Zero();
+      Eigen::Matrix<double, 3, 3> bp = Eigen::Matrix3d::Zero();
+      Eigen::Matrix3d br = Eigen::Matrix3d::Zero();
+      int n = 0;
+      for (size_t k = lo; k < hi; ++k) {
+        if (!use[k - lo]) continue;
+        const double dt = (in.stamps[k] - in.stamps[i]).seconds();
+        const Eigen::Vector3d q(1.0, dt, dt * dt);
+        Ap += q * q.transpose();
+        bp += q * in.T_world_body[k].t.transpose();
+        br += q * rotation_vector(Ti.R.transpose() * in.T_world_body[k].R).transpose();
+        ++n;
+      }
+      if (n < 5) return false;
+      const Eigen::Matrix3d cp = Ap.ldlt().solve(bp), cr = Ap.ldlt().solve(br);
+      p = cp.row(0).transpose();
+      w = cr.row(0).transpose();
+      if (misfit) {
+        misfit->clear();
+        for (size_t k = lo; k < hi; ++k) {
+          const double dt = (in.stamps[k] - in.stamps[i]).seconds();
+          const Eigen::Vector3d q(1.0, dt, dt * dt);
+          misfit->push_back((in.T_world_body[k].t - cp.transpose() * q).norm());
+        }
+      }
+      return true;
+    };
+    std::vector<char> use(hi - lo, 1);
+    std::vector<double> misfit;
+    Eigen::Vector3d p, w;
+    bool ok = true;
+    for (int it = 0; it < 4 && ok; ++it) {  // fit, keep the fixes within the cut of it, again
+      ok = fit(use, p, w, &misfit);
+      std::vector<char> next(use.size());
+      for (size_t k = 0; k < use.size(); ++k) next[k] = misfit[k] <= cut;
+      if (next == use) break;
+      use.swap(next);
+    }
+    if (!ok || !fit(use, p, w, nullptr)) continue;
+    out.T_world_body[i].t = p;
+    out.T_world_body[i].R = Ti.R * rotation_from_vector(w);
+  }
+  return out;
+}
+
+std::vector<MotionPair> motion_pairs(const Trajectory& lidar, const Trajectory& raw_gnss,
                                      const PairOptions& o) {
+  const Trajectory gnss = smooth_poses(raw_gnss, o.gnss_half_window_s);
   std::vector<MotionPair> pairs;
   const Time offset = Time::from_seconds(o.time_offset_s);
   const Time spacing = Time::from_seconds(o.spacing_s), max_gap = Time::from_seconds(o.max_gap_s);

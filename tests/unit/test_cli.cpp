@@ -544,8 +544,9 @@ TEST_F(Cli, HandEyeReadsGnssFixes) {
   for (int i = 0; i < 3; ++i) {
     EXPECT_NEAR(jf["T_gnss_lidar"]["t_m"][i].get<double>(),
                 jt["T_gnss_lidar"]["t_m"][i].get<double>(), 1e-4);
+    // 1e-3 deg: the local smoothing's outlier cut and the Huber weights can flip on rounding.
     EXPECT_NEAR(jf["T_gnss_lidar"]["roll_pitch_yaw_deg"][i].get<double>(),
-                jt["T_gnss_lidar"]["roll_pitch_yaw_deg"][i].get<double>(), 1e-4);
+                jt["T_gnss_lidar"]["roll_pitch_yaw_deg"][i].get<double>(), 1e-3);
   }
   // A missing column and a latitude out of range are named with file and line.
   const fs::path bad = write("bad.csv", "time,latitude,longitude,height,roll,pitch\n0,1,2,3,4,5\n");
