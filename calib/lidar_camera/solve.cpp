@@ -1,5 +1,7 @@
 #include "rigcal/lidar_camera/solve.h"
 
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
 #include <fmt/format.h>
 
 #include <Eigen/Dense>
@@ -30,6 +32,28 @@ Eigen::Matrix3d residual_covariance(const BoardPair& p, const SE3& T) {
   Jl(2, 2) = -1.0;
   return p.camera.covariance + Jl * p.lidar.covariance * Jl.transpose();
 }
+
+// residual() for Ceres: the extrinsic is (exp(dr) R0, t0 + dt), the residual whitened by W.
+struct PlaneError {
+  Eigen::Matrix3d W, R0;
+  Eigen::Vector3d t0, n_lidar;
+  Eigen::Matrix<double, 3, 2> B_camera;  // tangent(n_camera)
+  double d_camera, d_lidar;
+  template <typename S>
+  bool operator()(const S* dr, const S* dt, S* out) const {
+    S R[9];
+    ceres::AngleAxisToRotationMatrix(dr, ceres::ColumnMajorAdapter3x3(R));
+    const Eigen::Map<const Eigen::Matrix<S, 3, 3>> Rd(R);  // column-major
+    const Eigen::Matrix<S, 3, 1> n = Rd * (R0 * n_lidar).cast<S>();
+    const Eigen::Matrix<S, 3, 1> t = t0.cast<S>() + Eigen::Map<const Eigen::Matrix<S, 3, 1>>(dt);
+    Eigen::Matrix<S, 3, 1> r;
+    r.template head<2>() = B_camera.transpose().cast<S>() * n;
+    r[2] = S(d_camera) - (S(d_lidar) + n.dot(t));
+    Eigen::Map<Eigen::Matrix<S, 3, 1>> result(out);
+    result = W.cast<S>() * r;
+    return true;
+  }
+};
 
 }  // namespace
 
@@ -96,7 +120,9 @@ Solution solve(const std::vector<BoardPair>& pairs, double huber) {
   }
   T.t = A.colPivHouseholderQr().solve(b);
   out.closed_form = T;
-  // Gauss-Newton with whitened residuals and Huber weights (IRLS).
+  // Ceres over SE(3) (a left rotation vector and a translation added to the closed form), the
+  // residuals whitened by the planes' covariances at the current extrinsic, Huber loss; solved
+  // twice, the second time whitened at the first solution.
   std::vector<Eigen::Matrix3d> W(pairs.size());
   auto whiten = [&] {
     for (size_t k = 0; k < pairs.size(); ++k) {
@@ -104,29 +130,43 @@ Solution solve(const std::vector<BoardPair>& pairs, double huber) {
                  .matrixU();  // W^T W = Sigma^-1
     }
   };
-  whiten();
-  Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
-  for (int it = 0; it < 30; ++it) {
-    H.setZero();
-    Vec6 g = Vec6::Zero();
+  for (int round = 0; round < 2; ++round) {
+    whiten();
+    double dr[3] = {0, 0, 0}, dt[3] = {0, 0, 0};
+    ceres::Problem problem;
     for (size_t k = 0; k < pairs.size(); ++k) {
-      const Eigen::Vector3d r = W[k] * residual(pairs[k], T);
-      Eigen::Matrix<double, 3, 6> J;
-      for (int c = 0; c < 6; ++c) {
-        Vec6 d = Vec6::Zero();
-        d[c] = 1e-7;
-        J.col(c) = W[k] *
-                   (residual(pairs[k], perturbed(T, d)) - residual(pairs[k], perturbed(T, -d))) /
-                   2e-7;
-      }
-      const double w = r.norm() <= huber ? 1.0 : huber / r.norm();
-      H += w * J.transpose() * J;
-      g += w * J.transpose() * r;
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PlaneError, 3, 3, 3>(new PlaneError{
+                                   W[k], T.R, T.t, pairs[k].lidar.n, tangent(pairs[k].camera.n),
+                                   pairs[k].camera.d, pairs[k].lidar.d}),
+                               new ceres::HuberLoss(huber), dr, dt);
     }
-    const Vec6 step = H.ldlt().solve(-g);
-    T = perturbed(T, step);
-    if (it == 2) whiten();  // the covariances at the refined extrinsic
-    if (step.norm() < 1e-12) break;
+    ceres::Solver::Options options;
+    options.linear_solver_type = ceres::DENSE_QR;
+    options.function_tolerance = 1e-14;
+    options.parameter_tolerance = 1e-14;
+    options.gradient_tolerance = 1e-16;
+    options.max_num_iterations = 100;
+    ceres::Solver::Summary summary;
+    ceres::Solve(options, &problem, &summary);
+    Vec6 d;
+    d << dr[0], dr[1], dr[2], dt[0], dt[1], dt[2];
+    T = perturbed(T, d);
+  }
+  // The information matrix at the solution (the whitened Jacobian, Huber-weighted like the loss's
+  // second-order approximation): its inverse is the covariance.
+  Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    const Eigen::Vector3d r = W[k] * residual(pairs[k], T);
+    Eigen::Matrix<double, 3, 6> J;
+    for (int c = 0; c < 6; ++c) {
+      Vec6 d = Vec6::Zero();
+      d[c] = 1e-7;
+      J.col(c) = W[k] *
+                 (residual(pairs[k], perturbed(T, d)) - residual(pairs[k], perturbed(T, -d))) /
+                 2e-7;
+    }
+    const double w = r.norm() <= huber ? 1.0 : huber / r.norm();
+    H += w * J.transpose() * J;
   }
   out.T_camera_lidar = T;
   out.residuals = residuals_at(pairs, T);

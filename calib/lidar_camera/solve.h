@@ -3,9 +3,9 @@
 // doc/lidar-camera.md). A plane n_l . x = d_l in the LiDAR frame is, in the camera frame,
 // (R n_l) . x = d_l + (R n_l) . t; the camera sees n_c . x = d_c. So R takes the LiDAR normals to
 // the camera's (Kabsch), and n_c . t = d_c - d_l (least squares): at least 3 boards whose normals
-// span space. Then Gauss-Newton on the per-board residuals (2 normal angles, 1 distance), each
-// whitened by the two planes' covariances (the camera's from the corner noise, the LiDAR's from
-// its points' scatter), Huber-weighted.
+// span space. Then Ceres over SE(3) on the per-board residuals (2 normal angles, 1 distance),
+// each whitened by the two planes' covariances (the camera's from the corner noise, the LiDAR's
+// from its points' scatter), with a Huber loss.
 #include <Eigen/Core>
 #include <optional>
 #include <string>
