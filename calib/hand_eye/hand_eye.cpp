@@ -3,6 +3,7 @@
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 #include <fmt/format.h>
+#include <tbb/parallel_for.h>
 
 #include <Eigen/SVD>
 #include <algorithm>
@@ -288,58 +289,56 @@ Trajectory smooth_poses(const Trajectory& in, double half_window_s) {
     }
   }
   const double cut = std::max(0.05, 5.0 * std::sqrt(noise));
-  size_t lo = 0, hi = 0;
-  for (size_t i = 0; i < in.size(); ++i) {
-    while (in.stamps[lo] < in.stamps[i] - h) ++lo;
-    while (hi < in.size() && in.stamps[hi] <= in.stamps[i] + h) ++hi;
-    if (hi - lo < 5) continue;
-    const SE3& Ti = in.T_world_body[i];
-    // Rows 1, dt, dt^2: positions, and rotation vectors relative to the pose's own (a linear fit
+  tbb::parallel_for(size_t{0}, in.size(), [&](size_t i) {
+    const size_t lo = static_cast<size_t>(
+        std::lower_bound(in.stamps.begin(), in.stamps.end(), in.stamps[i] - h) - in.stamps.begin());
+    const size_t hi = static_cast<size_t>(
+        std::upper_bound(in.stamps.begin(), in.stamps.end(), in.stamps[i] + h) - in.stamps.begin());
+    if (hi - lo < 5) return;
+    // Rows 1, dt, dt^2: positions, then rotation vectors relative to the pose's own (a linear fit
     // would be biased by the angular acceleration: alpha h^2 / 6, 0.1 deg on a hand-held rig).
-    auto fit = [&](const std::vector<char>& use, Eigen::Vector3d& p, Eigen::Vector3d& w,
-                   std::vector<double>* misfit) {
-      Eigen::Matrix3d Ap = Eigen::Matrix3d::Zero();
-      Eigen::Matrix<double, 3, 3> bp = Eigen::Matrix3d::Zero();
-      Eigen::Matrix3d br = Eigen::Matrix3d::Zero();
+    const size_t m = hi - lo;
+    std::vector<Eigen::Vector3d> q(m);
+    for (size_t k = 0; k < m; ++k) {
+      const double dt = (in.stamps[lo + k] - in.stamps[i]).seconds();
+      q[k] = Eigen::Vector3d(1.0, dt, dt * dt);
+    }
+    std::vector<char> use(m, 1);
+    Eigen::Matrix3d Ap, cp;
+    auto normal_matrix = [&] {
+      Ap.setZero();
       int n = 0;
-      for (size_t k = lo; k < hi; ++k) {
-        if (!use[k - lo]) continue;
-        const double dt = (in.stamps[k] - in.stamps[i]).seconds();
-        const Eigen::Vector3d q(1.0, dt, dt * dt);
-        Ap += q * q.transpose();
-        bp += q * in.T_world_body[k].t.transpose();
-        br += q * rotation_vector(Ti.R.transpose() * in.T_world_body[k].R).transpose();
-        ++n;
+      for (size_t k = 0; k < m; ++k) {
+        if (use[k]) Ap += q[k] * q[k].transpose(), ++n;
       }
-      if (n < 5) return false;
-      const Eigen::Matrix3d cp = Ap.ldlt().solve(bp), cr = Ap.ldlt().solve(br);
-      p = cp.row(0).transpose();
-      w = cr.row(0).transpose();
-      if (misfit) {
-        misfit->clear();
-        for (size_t k = lo; k < hi; ++k) {
-          const double dt = (in.stamps[k] - in.stamps[i]).seconds();
-          const Eigen::Vector3d q(1.0, dt, dt * dt);
-          misfit->push_back((in.T_world_body[k].t - cp.transpose() * q).norm());
-        }
-      }
-      return true;
+      return n >= 5;
     };
-    std::vector<char> use(hi - lo, 1);
-    std::vector<double> misfit;
-    Eigen::Vector3d p, w;
     bool ok = true;
-    for (int it = 0; it < 4 && ok; ++it) {  // fit, keep the fixes within the cut of it, again
-      ok = fit(use, p, w, &misfit);
-      std::vector<char> next(use.size());
-      for (size_t k = 0; k < use.size(); ++k) next[k] = misfit[k] <= cut;
+    for (int it = 0; it < 4; ++it) {  // fit, keep the fixes within the cut of it, again
+      if (!(ok = normal_matrix())) break;
+      Eigen::Matrix3d bp = Eigen::Matrix3d::Zero();
+      for (size_t k = 0; k < m; ++k) {
+        if (use[k]) bp += q[k] * in.T_world_body[lo + k].t.transpose();
+      }
+      cp = Ap.ldlt().solve(bp);
+      std::vector<char> next(m);
+      for (size_t k = 0; k < m; ++k)
+        next[k] = (in.T_world_body[lo + k].t - cp.transpose() * q[k]).norm() <= cut;
       if (next == use) break;
       use.swap(next);
     }
-    if (!ok || !fit(use, p, w, nullptr)) continue;
-    out.T_world_body[i].t = p;
-    out.T_world_body[i].R = Ti.R * rotation_from_vector(w);
-  }
+    if (!ok || !normal_matrix()) return;
+    const SE3& Ti = in.T_world_body[i];
+    Eigen::Matrix3d bp = Eigen::Matrix3d::Zero(), br = Eigen::Matrix3d::Zero();
+    for (size_t k = 0; k < m; ++k) {
+      if (!use[k]) continue;
+      bp += q[k] * in.T_world_body[lo + k].t.transpose();
+      br += q[k] * rotation_vector(Ti.R.transpose() * in.T_world_body[lo + k].R).transpose();
+    }
+    const Eigen::LDLT<Eigen::Matrix3d> ldlt(Ap);
+    out.T_world_body[i].t = ldlt.solve(bp).row(0).transpose();
+    out.T_world_body[i].R = Ti.R * rotation_from_vector(ldlt.solve(br).row(0).transpose());
+  });
   return out;
 }
 
