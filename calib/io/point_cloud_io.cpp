@@ -34,43 +34,32 @@ size_t datatype_size(int t) {
   return t >= 1 && t <= 8 ? sizes[t] : 0;
 }
 
+template <typename V>
+double load(const char* p) {
+  V v;
+  std::memcpy(&v, p, sizeof v);
+  return static_cast<double>(v);
+}
+
 double field_value(const char* record, const Field& f) {
   const char* p = record + f.offset;
   switch (f.datatype) {
     case 1:
-      return static_cast<double>(*reinterpret_cast<const int8_t*>(p));
+      return load<int8_t>(p);
     case 2:
-      return static_cast<double>(*reinterpret_cast<const uint8_t*>(p));
-    case 3: {
-      int16_t v;
-      std::memcpy(&v, p, 2);
-      return v;
-    }
-    case 4: {
-      uint16_t v;
-      std::memcpy(&v, p, 2);
-      return v;
-    }
-    case 5: {
-      int32_t v;
-      std::memcpy(&v, p, 4);
-      return v;
-    }
-    case 6: {
-      uint32_t v;
-      std::memcpy(&v, p, 4);
-      return v;
-    }
-    case 7: {
-      float v;
-      std::memcpy(&v, p, 4);
-      return v;
-    }
-    default: {
-      double v;
-      std::memcpy(&v, p, 8);
-      return v;
-    }
+      return load<uint8_t>(p);
+    case 3:
+      return load<int16_t>(p);
+    case 4:
+      return load<uint16_t>(p);
+    case 5:
+      return load<int32_t>(p);
+    case 6:
+      return load<uint32_t>(p);
+    case 7:
+      return load<float>(p);
+    default:
+      return load<double>(p);
   }
 }
 
@@ -253,14 +242,7 @@ std::vector<Eigen::Vector3d> read_pcd(const std::filesystem::path& path) {
     }
     auto val = [&](size_t k, int i) {
       const char* p = buf.data() + k * stride + offset[i];
-      if (sizes[i] == 4) {
-        float v;
-        std::memcpy(&v, p, 4);
-        return static_cast<double>(v);
-      }
-      double v;
-      std::memcpy(&v, p, 8);
-      return v;
+      return sizes[i] == 4 ? load<float>(p) : load<double>(p);
     };
     for (size_t k = 0; k < points; ++k) keep(out, val(k, ix), val(k, iy), val(k, iz));
   } else {
