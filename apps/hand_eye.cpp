@@ -23,14 +23,18 @@ namespace {
 struct Options {
   std::string lidar, gnss, sensor = "gnss", lidar_sensor = "lidar", rig, out, report;
   std::string duplicates = "error", attitude;
-  std::vector<std::string> fix;  // AXIS=VALUE, GNSS/INS frame
+  std::vector<std::string> fix;    // AXIS=VALUE, GNSS/INS frame
+  std::vector<std::string> prior;  // AXIS=VALUE,SIGMA
   double spacing_s = 1.0, stride_s = 0.1, min_rotation_deg = 1.0, rotation_sigma_deg = 0.05,
          translation_sigma_m = 0.02, max_sigma_m = 0.05, gnss_smoothing_s = 0.05;
   bool estimate_offset = false;
 };
 
-std::vector<hand_eye::RefineOptions::Fixed> parse_fixes(const std::vector<std::string>& specs) {
+// --fix AXIS=METRES, or (with_sigma) --prior AXIS=METRES,SIGMA.
+std::vector<hand_eye::RefineOptions::Fixed> parse_fixes(const std::vector<std::string>& specs,
+                                                        bool with_sigma) {
   std::vector<hand_eye::RefineOptions::Fixed> out;
+  const char* option = with_sigma ? "--prior" : "--fix";
   for (const std::string& s : specs) {
     const size_t eq = s.find('=');
     const std::string axis = s.substr(0, eq);
@@ -38,16 +42,22 @@ std::vector<hand_eye::RefineOptions::Fixed> parse_fixes(const std::vector<std::s
     if (axis == "x") d.x() = 1;
     if (axis == "y") d.y() = 1;
     if (axis == "z") d.z() = 1;
-    double v = 0;
+    std::vector<double> v;
     try {
       if (eq == std::string::npos) throw Error("");
-      v = parse_double(std::string_view(s).substr(eq + 1), "--fix");
+      for (std::string_view f : split_fields(std::string_view(s).substr(eq + 1)))
+        v.push_back(parse_double(f, option));
     } catch (const Error&) {
       d.setZero();
     }
-    if (d.isZero())
-      throw Error(fmt::format("--fix '{}': expected x=METRES, y=METRES or z=METRES", s));
-    out.push_back({d, v});
+    if (d.isZero() || v.size() != (with_sigma ? 2u : 1u) || (with_sigma && !(v[1] > 0))) {
+      throw Error(with_sigma
+                      ? fmt::format("--prior '{}': expected x=METRES,SIGMA (SIGMA > 0), "
+                                    "y=... or z=...",
+                                    s)
+                      : fmt::format("--fix '{}': expected x=METRES, y=METRES or z=METRES", s));
+    }
+    out.push_back({d, v[0], with_sigma ? v[1] : 0.0});
   }
   return out;
 }
@@ -144,7 +154,8 @@ void run(const Options& o) {
   hand_eye::RefineOptions ro;
   ro.rotation_sigma_deg = o.rotation_sigma_deg;
   ro.translation_sigma_m = o.translation_sigma_m;
-  ro.fixed = parse_fixes(o.fix);
+  ro.fixed = parse_fixes(o.fix, false);
+  for (const hand_eye::RefineOptions::Fixed& p : parse_fixes(o.prior, true)) ro.fixed.push_back(p);
   if (sync) {
     notes.push_back(fmt::format(
         "clock offset estimated from the trajectories' angular velocities: t_lidar = t_gnss + "
@@ -174,7 +185,8 @@ void run(const Options& o) {
     const Eigen::Vector3d d = ob.translation_directions.col(i);
     fmt::print(stderr,
                "rigcal: the motion does not determine the translation along [{:.3f} {:.3f} "
-               "{:.3f}] (GNSS/INS frame; {}): give --fix (e.g. z=0.35) or a --rig whose "
+               "{:.3f}] (GNSS/INS frame; {}): give --fix (e.g. z=0.35), --prior (z=0.35,0.02) or a "
+               "--rig whose "
                "extrinsic holds it; nothing written\n",
                d.x(), d.y(), d.z(), why(i));
   }
@@ -183,7 +195,7 @@ void run(const Options& o) {
     const Eigen::Vector3d d = ob.translation_directions.col(i);
     notes.push_back(fmt::format(
         "translation along [{:.3f} {:.3f} {:.3f}] (GNSS/INS frame) is not determined by the "
-        "motion ({}): kept from the rig, {:.4f} m; give --fix to set it",
+        "motion ({}): kept from the rig, {:.4f} m; give --fix or --prior to set it",
         d.x(), d.y(), d.z(), why(i), d.dot(prior_T_gnss_lidar->t)));
   }
   const hand_eye::Refined r = hand_eye::refine(pairs, cf.T_gnss_lidar, ro);
@@ -237,8 +249,9 @@ void add_hand_eye(CLI::App& app) {
       "The GNSS/INS-to-LiDAR extrinsic from the LiDAR odometry and the GNSS/INS trajectory\n"
       "(doc/hand-eye.md): motion pairs, closed form, robust refinement, covariance, and the\n"
       "directions the motion does not determine (a car on a plane leaves the vertical offset\n"
-      "free: give --fix z=METRES, or the rig's value is kept and said so). Inputs: TUM, KITTI\n"
-      "with times, EuRoC. Exit 0; 2 on bad input, 3 when a direction is undetermined and\n"
+      "free: give --fix z=METRES or --prior z=METRES,SIGMA, or the rig's value is kept and said\n"
+      "so). Inputs: TUM, KITTI with times, EuRoC. Exit 0; 2 on bad input, 3 when a direction is "
+      "undetermined and\n"
       "nothing fixes it: nothing written in either case.");
   cmd->add_option("--lidar", o->lidar, "LiDAR odometry trajectory (T_odom_lidar)")->required();
   cmd->add_option("--gnss", o->gnss,
@@ -263,6 +276,9 @@ void add_hand_eye(CLI::App& app) {
                   "report folder: hand_eye.json, residuals.png, "
                   "trajectories.png");
   cmd->add_option("--fix", o->fix, "hold a translation component (GNSS/INS frame): z=0.35");
+  cmd->add_option("--prior", o->prior,
+                  "a translation component's prior with its 1-sigma (GNSS/INS frame, m): "
+                  "z=0.35,0.02; weighed with the motion, and carried into the covariance");
   cmd->add_flag("--estimate-offset", o->estimate_offset,
                 "estimate the clock offset from the trajectories' angular velocities (around "
                 "the rig's value, +-1 s) and write it as the sensor's time_offset");

@@ -50,16 +50,19 @@ struct PairError {
   }
 };
 
+// A held component (sigma 1e-6 m: stiff) or a prior with its sigma.
 struct FixedError {
   Eigen::Vector3d direction;
-  double value;
+  double value, sigma;
   template <typename T>
   bool operator()(const T* t_x, T* r) const {
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> tX(t_x);
-    r[0] = (direction.cast<T>().dot(tX) - T(value)) / T(1e-6);
+    r[0] = (direction.cast<T>().dot(tX) - T(value)) / T(sigma);
     return true;
   }
 };
+
+double fixed_sigma(const RefineOptions::Fixed& f) { return f.sigma_m > 0 ? f.sigma_m : 1e-6; }
 
 }  // namespace
 
@@ -164,11 +167,13 @@ Eigen::Matrix<double, 7, 7> sandwich_covariance(const std::vector<MotionPair>& p
       S += w * (g * gm.transpose() + gm * g.transpose());
     }
   }
-  // Held translation components and, when not estimated, the scale: stiff priors.
+  // Held translation components and, when not estimated, the scale: stiff priors. A prior with
+  // a sigma adds its information to H and, its whitened residual having unit variance, to S.
   for (const RefineOptions::Fixed& f : o.fixed) {
     Vec7 a = Vec7::Zero();
-    a.segment<3>(3) = f.direction.normalized() / 1e-6;
+    a.segment<3>(3) = f.direction.normalized() / fixed_sigma(f);
     H += a * a.transpose();
+    if (f.sigma_m > 0) S += a * a.transpose();
   }
   if (!o.estimate_scale) H(6, 6) += 1e18;
   const Mat7 Hinv = H.inverse();
@@ -191,8 +196,8 @@ Refined solve(const std::vector<MotionPair>& pairs, const SE3& initial, double i
         new ceres::HuberLoss(o.huber), q.coeffs().data(), t.data(), &scale);
   }
   for (const RefineOptions::Fixed& f : o.fixed) {
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<FixedError, 1, 3>(
-                                 new FixedError{f.direction.normalized(), f.value_m}),
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<FixedError, 1, 3>(new FixedError{
+                                 f.direction.normalized(), f.value_m, fixed_sigma(f)}),
                              nullptr, t.data());
   }
   problem.SetManifold(q.coeffs().data(), new ceres::EigenQuaternionManifold);

@@ -47,9 +47,10 @@ struct PairOptions {
 // Each pose replaced by a local fit over the poses within +- half_window_s of it: positions by a
 // least-squares quadratic in time, orientations likewise by their rotation vectors relative to
 // the pose's own; fixes beyond 5 sigmas (and 5 cm; sigma from the trajectory's second
-// differences, robustly) of a window's fit are left out of it, and it is fitted again (a multipath jump is neither spread to its neighbours nor kept). Poses with
-// fewer than 5 neighbours in the window stay as they are. The motion must be smooth on that
-// scale: a walk's 2 Hz bounce of 2.5 cm is followed to 0.2 mm by +-0.05 s.
+// differences, robustly) of a window's fit are left out of it, and it is fitted again (a multipath
+// jump is neither spread to its neighbours nor kept). Poses with fewer than 5 neighbours in the
+// window stay as they are. The motion must be smooth on that scale: a walk's 2 Hz bounce of 2.5 cm
+// is followed to 0.2 mm by +-0.05 s.
 Trajectory smooth_poses(const Trajectory& trajectory, double half_window_s);
 
 // Pairs along the GNSS/INS trajectory (smoothed, options.gnss_half_window_s): a GNSS/INS pose at
@@ -114,10 +115,13 @@ struct RefineOptions {
   double translation_sigma_m = 0.02;
   double huber = 3.0;  // robust loss width, in those sigmas
   // Translation components held at a value, not estimated: t . direction = value (a unit
-  // direction in the GNSS/INS frame; e.g. the vertical on a car, with the value measured by tape).
+  // direction in the GNSS/INS frame; e.g. the vertical on a car, with the value measured by tape);
+  // or, with sigma_m > 0, a prior: t . direction = value +- sigma_m, weighed with the pairs (the
+  // covariance then carries the prior's sigma along that direction).
   struct Fixed {
     Eigen::Vector3d direction;
     double value_m = 0.0;
+    double sigma_m = 0.0;  // 0: held exactly
   };
   std::vector<Fixed> fixed;
   // A scale factor on every LiDAR translation t_A, estimated with X: LiDAR odometry's scale error

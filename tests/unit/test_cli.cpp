@@ -656,6 +656,19 @@ TEST_F(Cli, HandEyeWritesTheExtrinsicAndRefusesAnUndeterminedDirection) {
   ASSERT_EQ(r.status, 0) << r.err;
   const nlohmann::json j2 = nlohmann::json::parse(slurp(fs::path(rep2) / "hand_eye.json"));
   EXPECT_NEAR(j2["T_gnss_lidar"]["t_m"][2].get<double>(), -0.1399, 1e-4);
+  // With --prior it answers too, within the prior's sigma of the truth, and the covariance
+  // carries that sigma along the vertical (the motion adds next to nothing there).
+  const std::string rep3 = (dir_ / "rep3").string();
+  r = run("hand-eye" + args(car) + " --prior z=-0.13,0.02 --report " + rep3);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j3 = nlohmann::json::parse(slurp(fs::path(rep3) / "hand_eye.json"));
+  EXPECT_NEAR(j3["T_gnss_lidar"]["t_m"][2].get<double>(), -0.1399, 0.02);
+  const double sz = j3["T_gnss_lidar"]["t_sigma_m"][2].get<double>();
+  EXPECT_GT(sz, 0.015);
+  EXPECT_LE(sz, 0.0201);
+  r = run("hand-eye" + args(car) + " --prior z=-0.13");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("expected x=METRES,SIGMA"), std::string::npos) << r.err;
   // Trajectories that do not overlap in time, and too few pairs: exit 2.
   const fs::path a = write("a.tum", "0 0 0 0 0 0 0 1\n1 1 0 0 0 0 0 1\n2 2 0 0 0 0 0 1\n");
   const fs::path b = write("b.tum", "100 0 0 0 0 0 0 1\n101 1 0 0 0 0 0 1\n102 2 0 0 0 0 0 1\n");
