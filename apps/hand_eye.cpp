@@ -250,9 +250,8 @@ void add_hand_eye(CLI::App& app) {
       "(doc/hand-eye.md): motion pairs, closed form, robust refinement, covariance, and the\n"
       "directions the motion does not determine (a car on a plane leaves the vertical offset\n"
       "free: give --fix z=METRES or --prior z=METRES,SIGMA, or the rig's value is kept and said\n"
-      "so). Inputs: TUM, KITTI with times, EuRoC. Exit 0; 2 on bad input, 3 when a direction is "
-      "undetermined and\n"
-      "nothing fixes it: nothing written in either case.");
+      "so). Inputs: TUM, KITTI with times, EuRoC. Exit 0; 2 on bad input, 3 when a\n"
+      "direction is undetermined and nothing fixes it: nothing written in either case.");
   cmd->add_option("--lidar", o->lidar, "LiDAR odometry trajectory (T_odom_lidar)")->required();
   cmd->add_option("--gnss", o->gnss,
                   "GNSS/INS trajectory (T_enu_gnss; TUM, KITTI, EuRoC, OpenCalib), or a CSV of "
