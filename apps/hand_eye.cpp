@@ -156,6 +156,7 @@ void run(const Options& o) {
   ro.translation_sigma_m = o.translation_sigma_m;
   ro.fixed = parse_fixes(o.fix, false);
   for (const hand_eye::RefineOptions::Fixed& p : parse_fixes(o.prior, true)) ro.fixed.push_back(p);
+  ro.estimate_time_offset = sync.has_value();
   if (sync) {
     notes.push_back(fmt::format(
         "clock offset estimated from the trajectories' angular velocities: t_lidar = t_gnss + "
@@ -200,6 +201,15 @@ void run(const Options& o) {
   }
   const hand_eye::Refined r = hand_eye::refine(pairs, cf.T_gnss_lidar, ro);
   const SE3& X = r.T_gnss_lidar;
+  if (sync) {
+    // The angular-velocity estimate, refined with the extrinsic (the pairs' LiDAR motion moved
+    // with the clock to first order).
+    offset_s += r.time_offset_correction_s;
+    notes.push_back(fmt::format(
+        "clock offset refined with the extrinsic: t_lidar = t_gnss + {:.6f} s, 1-sigma {:.6f} s "
+        "({:+.3f} ms from the angular velocities' estimate)",
+        offset_s, r.time_offset_sigma_s, 1e3 * r.time_offset_correction_s));
+  }
   const Eigen::Vector3d rpy = roll_pitch_yaw(X.R) * 180.0 / M_PI;
   const Eigen::Vector3d &sig_r = r.rotation_sigma_deg, &sig_t = r.translation_sigma_m;
   size_t outliers = 0;

@@ -29,26 +29,59 @@ std::optional<SE3> pose_at(const Trajectory& traj, Time t, Time max_gap) {
                             (t - a).seconds() / (b - a).seconds());
 }
 
+// The body-frame angular and linear velocity of `traj` at t, by central differences over +-50 ms
+// (one LiDAR period); zero where the poses are not there.
+void velocity(const Trajectory& traj, Time t, Time max_gap, Eigen::Vector3d& w,
+              Eigen::Vector3d& v) {
+  const Time h = Time::from_ns(50'000'000);
+  const auto a = pose_at(traj, t - h, max_gap), b = pose_at(traj, t + h, max_gap);
+  w.setZero(), v.setZero();
+  if (!a || !b) return;
+  const SE3 d = a->inverse() * *b;
+  w = rotation_vector(d.R) / 0.1;
+  v = d.t / 0.1;
+}
+
 // One pair: rotation 2 vec(q_B^-1 q_X q_A q_X^-1) and translation R_B t_X + t_B - R_X s t_A - t_X
 // (s: the odometry's scale correction), each over its sigma.
 struct PairError {
   Eigen::Quaterniond q_A, q_B;
   Eigen::Vector3d t_A, t_B;
+  Eigen::Vector3d w0, v0, w1, v1;  // the LiDAR's velocities at t0, t1 (MotionPair)
   double rot_sigma, trans_sigma;
   template <typename T>
-  bool operator()(const T* q_x, const T* t_x, const T* scale, T* r) const {
-    const Eigen::Map<const Eigen::Quaternion<T>> qX(q_x);
+  bool operator()(const T* q_x, const T* t_x, const T* scale, const T* dt, T* r) const {
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> tX(t_x);
-    const Eigen::Quaternion<T> qA = q_A.cast<T>(), qB = q_B.cast<T>();
+    const Eigen::Map<const Eigen::Quaternion<T>> qX(q_x);
+    // A(dt) = exp(-dt xi0) A exp(dt xi1), to first order in dt.
+    const Eigen::Matrix<T, 3, 1> a0 = -dt[0] * w0.cast<T>(), a1 = dt[0] * w1.cast<T>();
+    T c0[4], c1[4];  // w x y z
+    ceres::AngleAxisToQuaternion(a0.data(), c0);
+    ceres::AngleAxisToQuaternion(a1.data(), c1);
+    const Eigen::Quaternion<T> q0(c0[0], c0[1], c0[2], c0[3]), q1(c1[0], c1[1], c1[2], c1[3]);
+    const Eigen::Quaternion<T> qA = q0 * q_A.cast<T>() * q1;
+    const Eigen::Matrix<T, 3, 1> tA =
+        q0 * (t_A.cast<T>() + q_A.cast<T>() * (dt[0] * v1.cast<T>())) - dt[0] * v0.cast<T>();
+    const Eigen::Quaternion<T> qB = q_B.cast<T>();
     const Eigen::Quaternion<T> e = qB.conjugate() * qX * qA * qX.conjugate();
     const T sign = e.w() < T(0) ? T(-1) : T(1);
     for (int i = 0; i < 3; ++i) r[i] = sign * T(2) * e.vec()[i] / T(rot_sigma);
-    const Eigen::Matrix<T, 3, 1> et =
-        qB * tX + t_B.cast<T>() - qX * (scale[0] * t_A.cast<T>()) - tX;
+    const Eigen::Matrix<T, 3, 1> et = qB * tX + t_B.cast<T>() - qX * (scale[0] * tA) - tX;
     for (int i = 0; i < 3; ++i) r[3 + i] = et[i] / T(trans_sigma);
     return true;
   }
 };
+
+PairError pair_error(const MotionPair& p, double rot_sigma, double trans_sigma) {
+  return {p.A.quaternion(), p.B.quaternion(), p.A.t, p.B.t, p.w0, p.v0, p.w1, p.v1,
+          rot_sigma,        trans_sigma};
+}
+
+// The LiDAR's motion of a pair with the clock moved by dt (PairError's A(dt), in double).
+SE3 shifted_motion(const MotionPair& p, double dt) {
+  const Eigen::Matrix3d R0 = rotation_from_vector(-dt * p.w0), R1 = rotation_from_vector(dt * p.w1);
+  return SE3{R0 * p.A.R * R1, R0 * (p.A.t + p.A.R * (dt * p.v1)) - dt * p.v0};
+}
 
 // A held component (sigma 1e-6 m: stiff) or a prior with its sigma.
 struct FixedError {
@@ -113,7 +146,8 @@ size_t bartlett_window(const std::vector<MotionPair>& pairs, const std::vector<s
   return 2 * max_lag;
 }
 
-// The covariance of X's 6 parameters (rotation as a left perturbation, rad; then translation, m)
+// The covariance of X's 6 parameters (rotation as a left perturbation, rad; then translation, m),
+// the odometry's scale and the clock offset correction (s)
 // by the sandwich H^-1 S H^-1 over the inlier pairs (normalized residuals r_k, Jacobians J_k by
 // central differences): H = sum J_k^T J_k (plus the held directions), S = sum over pairs k, j
 // whose time intervals touch or overlap (they share GNSS/INS fixes or odometry steps, so their
@@ -121,21 +155,22 @@ size_t bartlett_window(const std::vector<MotionPair>& pairs, const std::vector<s
 // with L twice the largest such lag (Newey and West's estimator, generous in the window). With
 // independent pairs it is the usual covariance scaled by the residuals' level; with correlated
 // ones it does not count the same noise twice.
-Eigen::Matrix<double, 7, 7> sandwich_covariance(const std::vector<MotionPair>& pairs, const SE3& X,
-                                                double scale, const std::vector<bool>& outlier,
+Eigen::Matrix<double, 8, 8> sandwich_covariance(const std::vector<MotionPair>& pairs, const SE3& X,
+                                                double scale, double dt,
+                                                const std::vector<bool>& outlier,
                                                 const RefineOptions& o, double rot_sigma,
                                                 double trans_sigma) {
   using Vec6 = Eigen::Matrix<double, 6, 1>;
-  using Vec7 = Eigen::Matrix<double, 7, 1>;
-  using Mat67 = Eigen::Matrix<double, 6, 7>;
-  using Mat7 = Eigen::Matrix<double, 7, 7>;
+  using Vec7 = Eigen::Matrix<double, 8, 1>;
+  using Mat67 = Eigen::Matrix<double, 6, 8>;
+  using Mat7 = Eigen::Matrix<double, 8, 8>;
   auto residual = [&](const MotionPair& p, const Vec7& d) {
     const SE3 Xd = perturbed(X, d.head<6>());
-    const double sd = scale + d[6];
-    const PairError e{p.A.quaternion(), p.B.quaternion(), p.A.t, p.B.t, rot_sigma, trans_sigma};
+    const double sd = scale + d[6], dtd = dt + d[7];
+    const PairError e = pair_error(p, rot_sigma, trans_sigma);
     const Eigen::Quaterniond q = Xd.quaternion();
     Vec6 r;
-    e(q.coeffs().data(), Xd.t.data(), &sd, r.data());
+    e(q.coeffs().data(), Xd.t.data(), &sd, &dtd, r.data());
     return r;
   };
   std::vector<size_t> in;
@@ -149,7 +184,7 @@ Eigen::Matrix<double, 7, 7> sandwich_covariance(const std::vector<MotionPair>& p
   for (size_t n = 0; n < in.size(); ++n) {
     const MotionPair& p = pairs[in[n]];
     r[n] = residual(p, Vec7::Zero());
-    for (int c = 0; c < 7; ++c) {
+    for (int c = 0; c < 8; ++c) {
       Vec7 d = Vec7::Zero();
       d[c] = h;
       J[n].col(c) = (residual(p, d) - residual(p, -d)) / (2 * h);
@@ -176,6 +211,7 @@ Eigen::Matrix<double, 7, 7> sandwich_covariance(const std::vector<MotionPair>& p
     if (f.sigma_m > 0) S += a * a.transpose();
   }
   if (!o.estimate_scale) H(6, 6) += 1e18;
+  if (!o.estimate_time_offset) H(7, 7) += 1e18;
   const Mat7 Hinv = H.inverse();
   const double dof_correction =
       in.size() > 6 ? static_cast<double>(in.size()) / static_cast<double>(in.size() - 6) : 1.0;
@@ -184,16 +220,16 @@ Eigen::Matrix<double, 7, 7> sandwich_covariance(const std::vector<MotionPair>& p
 
 // One robust solve with the given per-pair sigmas (rad, m), its residuals, outliers and covariance.
 Refined solve(const std::vector<MotionPair>& pairs, const SE3& initial, double initial_scale,
-              const RefineOptions& o, double rot_sigma, double trans_sigma) {
+              double initial_dt, const RefineOptions& o, double rot_sigma, double trans_sigma) {
   Eigen::Quaterniond q = initial.quaternion();
   Eigen::Vector3d t = initial.t;
-  double scale = initial_scale;
+  double scale = initial_scale, dt = initial_dt;
   ceres::Problem problem;
   for (const MotionPair& p : pairs) {
-    problem.AddResidualBlock(
-        new ceres::AutoDiffCostFunction<PairError, 6, 4, 3, 1>(new PairError{
-            p.A.quaternion(), p.B.quaternion(), p.A.t, p.B.t, rot_sigma, trans_sigma}),
-        new ceres::HuberLoss(o.huber), q.coeffs().data(), t.data(), &scale);
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PairError, 6, 4, 3, 1, 1>(
+                                 new PairError(pair_error(p, rot_sigma, trans_sigma))),
+                             new ceres::HuberLoss(o.huber), q.coeffs().data(), t.data(), &scale,
+                             &dt);
   }
   for (const RefineOptions::Fixed& f : o.fixed) {
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<FixedError, 1, 3>(new FixedError{
@@ -202,6 +238,7 @@ Refined solve(const std::vector<MotionPair>& pairs, const SE3& initial, double i
   }
   problem.SetManifold(q.coeffs().data(), new ceres::EigenQuaternionManifold);
   if (!o.estimate_scale) problem.SetParameterBlockConstant(&scale);
+  if (!o.estimate_time_offset) problem.SetParameterBlockConstant(&dt);
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_QR;
   so.max_num_iterations = 100;
@@ -218,8 +255,9 @@ Refined solve(const std::vector<MotionPair>& pairs, const SE3& initial, double i
   // median of chi-square(6) is 5.35), so that sigmas set too small do not flag every pair.
   std::vector<double> z2s;
   for (const MotionPair& p : pairs) {
-    const double rr = rotation_angle((X.R * p.A.R).transpose() * (p.B.R * X.R));
-    const double tr = (p.B.R * X.t + p.B.t - X.R * (scale * p.A.t) - X.t).norm();
+    const SE3 A = shifted_motion(p, dt);
+    const double rr = rotation_angle((X.R * A.R).transpose() * (p.B.R * X.R));
+    const double tr = (p.B.R * X.t + p.B.t - X.R * (scale * A.t) - X.t).norm();
     out.pair_rotation_residual_deg.push_back(rr * 180.0 / M_PI);
     out.pair_translation_residual_m.push_back(tr);
     z2s.push_back(std::pow(rr / rot_sigma, 2) + std::pow(tr / trans_sigma, 2));
@@ -237,10 +275,12 @@ Refined solve(const std::vector<MotionPair>& pairs, const SE3& initial, double i
   const double dof =
       std::max(1.0, 6.0 * static_cast<double>(n_in) - 6.0 + static_cast<double>(o.fixed.size()));
   out.noise_scale = std::sqrt(ss / dof);
-  const Eigen::Matrix<double, 7, 7> C =
-      sandwich_covariance(pairs, X, scale, out.outlier, o, rot_sigma, trans_sigma);
+  const Eigen::Matrix<double, 8, 8> C =
+      sandwich_covariance(pairs, X, scale, dt, out.outlier, o, rot_sigma, trans_sigma);
   out.covariance = C.topLeftCorner<6, 6>();
   out.odometry_scale_sigma = o.estimate_scale ? std::sqrt(std::max(0.0, C(6, 6))) : 0.0;
+  out.time_offset_correction_s = dt;
+  out.time_offset_sigma_s = o.estimate_time_offset ? std::sqrt(std::max(0.0, C(7, 7))) : 0.0;
   for (int i = 0; i < 3; ++i) {
     out.rotation_sigma_deg[i] = std::sqrt(std::max(0.0, out.covariance(i, i))) * 180.0 / M_PI;
     out.translation_sigma_m[i] = std::sqrt(std::max(0.0, out.covariance(3 + i, 3 + i)));
@@ -255,8 +295,8 @@ Refined solve(const std::vector<MotionPair>& pairs, const SE3& initial, double i
 Refined refine(const std::vector<MotionPair>& pairs, const SE3& initial, const RefineOptions& o) {
   if (pairs.size() < 3)
     throw Error(fmt::format("{} motion pairs; at least 3 are needed", pairs.size()));
-  const Refined first =
-      solve(pairs, initial, 1.0, o, o.rotation_sigma_deg * M_PI / 180.0, o.translation_sigma_m);
+  const Refined first = solve(pairs, initial, 1.0, 0.0, o, o.rotation_sigma_deg * M_PI / 180.0,
+                              o.translation_sigma_m);
   // The two noise levels from the inlier residuals (RMS per component: a rotation residual has 3,
   // a translation residual 3), then solved again with them: a single scale on the given sigmas
   // would let a noisy rotation inflate the translation's covariance, or the reverse.
@@ -271,7 +311,8 @@ Refined refine(const std::vector<MotionPair>& pairs, const SE3& initial, const R
   if (n < 3) return first;
   const double rot_noise = std::sqrt(rr2 / (3.0 * n)), trans_noise = std::sqrt(tr2 / (3.0 * n));
   if (!(rot_noise > 1e-12 && trans_noise > 1e-12)) return first;
-  return solve(pairs, first.T_gnss_lidar, first.odometry_scale, o, rot_noise, trans_noise);
+  return solve(pairs, first.T_gnss_lidar, first.odometry_scale, first.time_offset_correction_s, o,
+               rot_noise, trans_noise);
 }
 
 Trajectory smooth_poses(const Trajectory& in, double half_window_s) {
@@ -367,7 +408,10 @@ std::vector<MotionPair> motion_pairs(const Trajectory& lidar, const Trajectory& 
     // A pair much longer than asked spans a GNSS/INS outage: skipped.
     if (L0 && L1 && (gnss.stamps[j] - gnss.stamps[i]) < spacing + spacing &&
         rotation_angle(B.R) >= min_rotation) {
-      pairs.push_back({t0, t1, L0->inverse() * *L1, B});
+      MotionPair p{t0, t1, L0->inverse() * *L1, B};
+      velocity(lidar, t0, max_gap, p.w0, p.v0);
+      velocity(lidar, t1, max_gap, p.w1, p.v1);
+      pairs.push_back(p);
     }
     i = stride == spacing
             ? j

@@ -24,6 +24,11 @@ struct MotionPair {
   Time t0, t1;  // on the LiDAR's clock
   SE3 A;        // T_L0_L1, the LiDAR's motion (odometry interpolated at t0, t1)
   SE3 B;        // T_G0_G1, the GNSS/INS's motion
+  // The LiDAR's body-frame angular (rad/s) and linear (m/s) velocities at t0 and t1: what A
+  // becomes when the clock offset moves by dt, A(dt) = exp(-dt xi0) A exp(dt xi1) (refine's
+  // time offset).
+  Eigen::Vector3d w0 = Eigen::Vector3d::Zero(), v0 = Eigen::Vector3d::Zero(),
+                  w1 = Eigen::Vector3d::Zero(), v1 = Eigen::Vector3d::Zero();
 };
 
 struct PairOptions {
@@ -128,6 +133,9 @@ struct RefineOptions {
   // (tenths of a percent are common) would otherwise leak into the lever arm in every turn
   // (simulated car at 10 m/s with 0.2 %: 2 cm in the plane).
   bool estimate_scale = true;
+  // A correction dt to the clock offset the pairs were built with, estimated with X (the LiDAR
+  // motion of each pair taken at t0 + dt, t1 + dt to first order): t_lidar = t_gnss + offset + dt.
+  bool estimate_time_offset = false;
 };
 
 struct Refined {
@@ -150,6 +158,8 @@ struct Refined {
   // The odometry's scale correction (GNSS/INS distance over LiDAR distance) and its 1-sigma;
   // 1 and 0 when not estimated.
   double odometry_scale = 1.0, odometry_scale_sigma = 0.0;
+  // With estimate_time_offset: the correction to the pairs' clock offset, and its 1-sigma (s).
+  double time_offset_correction_s = 0.0, time_offset_sigma_s = 0.0;
 };
 
 // The unobservable directions of `observability` that no entry of `fixed` covers (|cos| > 0.9)

@@ -43,6 +43,11 @@ std::vector<OutputFile> hand_eye_report_files(const std::filesystem::path& dir,
                        {"t_sigma_m", vec(sig_t)},
                        {"rotation_sigma_deg", vec(sig_r)},
                        {"matrix", {X.matrix().row(0), X.matrix().row(1), X.matrix().row(2)}}};
+  if (r.time_offset_sigma_s > 0) {  // estimated (--estimate-offset): refined with X
+    j["clock_offset"] = {{"gnss_time_offset_s", in.gnss_time_offset_s},
+                         {"sigma_s", r.time_offset_sigma_s},
+                         {"correction_in_refinement_s", r.time_offset_correction_s}};
+  }
   j["closed_form"] = {{"t_m", vec(cf.T_gnss_lidar.t)},
                       {"roll_pitch_yaw_deg", vec(roll_pitch_yaw(cf.T_gnss_lidar.R) * 180 / M_PI)},
                       {"axis_residual_rms_deg", cf.rotation_residual_rms_deg}};
