@@ -215,9 +215,11 @@ void run(const Options& o) {
   size_t outliers = 0;
   for (bool b : r.outlier) outliers += b;
 
-  fmt::print("{} motion pairs of {} s every {} s (LiDAR {} poses, GNSS/INS {} poses)\n",
-             pairs.size(), o.spacing_s, o.stride_s > 0 ? o.stride_s : o.spacing_s, lidar.size(),
-             gnss.size());
+  fmt::print(
+      "{} motion pairs of {} s every {} s (LiDAR {} poses, GNSS/INS {} poses); {} left out of the "
+      "closed form by the consensus\n",
+      pairs.size(), o.spacing_s, o.stride_s > 0 ? o.stride_s : o.spacing_s, lidar.size(),
+      gnss.size(), cf.rejected);
   fmt::print(
       "observability: rotation singular values {:.3f} {:.3f} {:.3f} rad; translation 1-sigma along "
       "its principal directions {:.4f} {:.4f} {:.4f} m\n",

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <random>
 
 #include "rigcal/bench/metrics.h"
 #include "rigcal/core/error.h"
@@ -422,12 +423,87 @@ std::vector<MotionPair> motion_pairs(const Trajectory& lidar, const Trajectory& 
   return pairs;
 }
 
-ClosedForm closed_form(const std::vector<MotionPair>& pairs, double max_sigma_m) {
-  if (pairs.size() < 3)
+namespace {
+
+double median_of(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+// Which pairs disagree with the consensus (closed_form's first step).
+std::vector<bool> consensus_outliers(const std::vector<MotionPair>& pairs) {
+  const size_t n = pairs.size();
+  std::vector<Eigen::Vector3d> a(n), b(n);
+  for (size_t k = 0; k < n; ++k)
+    a[k] = rotation_vector(pairs[k].A.R), b[k] = rotation_vector(pairs[k].B.R);
+  // Medians on at most 2000 pairs spread over the whole set.
+  const size_t step = std::max<size_t>(1, n / 2000);
+  std::mt19937_64 rng(12345);
+  std::uniform_int_distribution<size_t> pick(0, n - 1);
+  Eigen::Matrix3d best_R = Eigen::Matrix3d::Identity();
+  double best = INFINITY;
+  std::vector<double> res;
+  for (int it = 0, tried = 0; it < 300 && tried < 3000; ++tried) {
+    const size_t i = pick(rng), j = pick(rng);
+    const Eigen::Vector3d ai = a[i].normalized(), aj = a[j].normalized();
+    if (i == j || ai.cross(aj).norm() < std::sin(10.0 * M_PI / 180.0)) continue;  // axes apart
+    ++it;
+    const Eigen::Matrix3d R = nearest_rotation(b[i] * a[i].transpose() + b[j] * a[j].transpose());
+    res.clear();
+    for (size_t k = 0; k < n; k += step) res.push_back((b[k] - R * a[k]).norm());
+    const double m = median_of(res);
+    if (m < best) best = m, best_R = R;
+  }
+  std::vector<bool> outlier(n, false);
+  if (!std::isfinite(best)) return outlier;  // all axes parallel: no consensus to test against
+  const double rot_cut = std::max(0.1 * M_PI / 180.0, 3.0 * 1.4826 * best);
+  for (size_t k = 0; k < n; ++k) outlier[k] = (b[k] - best_R * a[k]).norm() > rot_cut;
+  // Translation: least squares on the rotation inliers, then 3 robust sigmas of it.
+  Eigen::Matrix3d MtM = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d Mty = Eigen::Vector3d::Zero();
+  for (size_t k = 0; k < n; ++k) {
+    if (outlier[k]) continue;
+    const Eigen::Matrix3d M = pairs[k].B.R - Eigen::Matrix3d::Identity();
+    MtM += M.transpose() * M;
+    Mty += M.transpose() * (best_R * pairs[k].A.t - pairs[k].B.t);
+  }
+  // Damped: a direction the motion does not determine stays near 0 instead of diverging.
+  const Eigen::Vector3d t =
+      (MtM + 1e-6 * MtM.trace() * Eigen::Matrix3d::Identity()).ldlt().solve(Mty);
+  std::vector<double> e(n);
+  std::vector<double> inlier_e;
+  for (size_t k = 0; k < n; ++k) {
+    e[k] =
+        ((pairs[k].B.R - Eigen::Matrix3d::Identity()) * t - (best_R * pairs[k].A.t - pairs[k].B.t))
+            .norm();
+    if (!outlier[k]) inlier_e.push_back(e[k]);
+  }
+  const double trans_cut = std::max(0.01, 3.0 * 1.4826 * median_of(inlier_e));
+  for (size_t k = 0; k < n; ++k) outlier[k] = outlier[k] || e[k] > trans_cut;
+  return outlier;
+}
+
+}  // namespace
+
+ClosedForm closed_form(const std::vector<MotionPair>& all_pairs, double max_sigma_m) {
+  if (all_pairs.size() < 3)
+    throw Error(fmt::format("{} motion pairs with enough rotation; at least 3 are needed",
+                            all_pairs.size()));
+  const std::vector<bool> outlier = consensus_outliers(all_pairs);
+  std::vector<MotionPair> pairs;
+  for (size_t k = 0; k < all_pairs.size(); ++k) {
+    if (!outlier[k]) pairs.push_back(all_pairs[k]);
+  }
+  if (pairs.size() < 3) {
     throw Error(
-        fmt::format("{} motion pairs with enough rotation; at least 3 are needed", pairs.size()));
+        fmt::format("{} motion pairs, {} of them agreeing with each other: at least 3 are needed",
+                    all_pairs.size(), pairs.size()));
+  }
   ClosedForm out;
-  out.pairs = pairs.size();
+  out.pairs = all_pairs.size();
+  out.outlier = outlier;
+  out.rejected = all_pairs.size() - pairs.size();
   // Rotation: axis(B) = R_X axis(A), each axis scaled by its angle (rotation vectors), so that
   // small, noisy rotations weigh less.
   Eigen::Matrix3d H = Eigen::Matrix3d::Zero(), S = Eigen::Matrix3d::Zero();

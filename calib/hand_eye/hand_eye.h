@@ -107,10 +107,18 @@ struct ClosedForm {
   SE3 T_gnss_lidar;
   Observability observability;
   size_t pairs = 0;
-  double rotation_residual_rms_deg = 0.0;  // of the axes after the fit
+  // Pairs left out as outliers before the fit (consensus below), and which.
+  size_t rejected = 0;
+  std::vector<bool> outlier;
+  double rotation_residual_rms_deg = 0.0;  // of the inliers' axes after the fit
 };
 
-// Throws rigcal::Error with fewer than 3 pairs.
+// Consensus first: rotations from random couples of pairs with different axes, the one with the
+// least median axis residual (least median of squares: up to half the pairs may be wrong) marks
+// the pairs beyond 3 robust sigmas of it (and 0.1 deg) as outliers; the translation's least
+// squares on the rest marks those beyond 3 robust sigmas (and 1 cm) of it. The closed form and
+// its observability figures then use the inliers. Throws rigcal::Error with fewer than 3 pairs
+// (or inliers).
 ClosedForm closed_form(const std::vector<MotionPair>& pairs, double max_sigma_m = 0.05);
 
 struct RefineOptions {

@@ -50,7 +50,8 @@ std::vector<OutputFile> hand_eye_report_files(const std::filesystem::path& dir,
   }
   j["closed_form"] = {{"t_m", vec(cf.T_gnss_lidar.t)},
                       {"roll_pitch_yaw_deg", vec(roll_pitch_yaw(cf.T_gnss_lidar.R) * 180 / M_PI)},
-                      {"axis_residual_rms_deg", cf.rotation_residual_rms_deg}};
+                      {"axis_residual_rms_deg", cf.rotation_residual_rms_deg},
+                      {"pairs_left_out_by_consensus", cf.rejected}};
   nlohmann::json unobs = nlohmann::json::array();
   for (int i : ob.unobservable) unobs.push_back(vec(ob.translation_directions.col(i)));
   j["observability"] = {
