@@ -186,9 +186,8 @@ void run(const Options& o) {
     const Eigen::Vector3d d = ob.translation_directions.col(i);
     fmt::print(stderr,
                "rigcal: the motion does not determine the translation along [{:.3f} {:.3f} "
-               "{:.3f}] (GNSS/INS frame; {}): give --fix (e.g. z=0.35), --prior (z=0.35,0.02) or a "
-               "--rig whose "
-               "extrinsic holds it; nothing written\n",
+               "{:.3f}] (GNSS/INS frame; {}): give --fix (e.g. z=0.35), --prior (z=0.35,0.02) "
+               "or a --rig whose extrinsic holds it; nothing written\n",
                d.x(), d.y(), d.z(), why(i));
   }
   if (!held.uncovered.empty()) throw Exit{3};

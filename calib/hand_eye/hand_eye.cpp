@@ -13,6 +13,7 @@
 
 #include "rigcal/bench/metrics.h"
 #include "rigcal/core/error.h"
+#include "rigcal/core/stats.h"
 
 namespace rigcal::hand_eye {
 namespace {
@@ -162,10 +163,10 @@ Eigen::Matrix<double, 8, 8> sandwich_covariance(const std::vector<MotionPair>& p
                                                 const RefineOptions& o, double rot_sigma,
                                                 double trans_sigma) {
   using Vec6 = Eigen::Matrix<double, 6, 1>;
-  using Vec7 = Eigen::Matrix<double, 8, 1>;
-  using Mat67 = Eigen::Matrix<double, 6, 8>;
-  using Mat7 = Eigen::Matrix<double, 8, 8>;
-  auto residual = [&](const MotionPair& p, const Vec7& d) {
+  using Vec8 = Eigen::Matrix<double, 8, 1>;
+  using Mat68 = Eigen::Matrix<double, 6, 8>;
+  using Mat8 = Eigen::Matrix<double, 8, 8>;
+  auto residual = [&](const MotionPair& p, const Vec8& d) {
     const SE3 Xd = perturbed(X, d.head<6>());
     const double sd = scale + d[6], dtd = dt + d[7];
     const PairError e = pair_error(p, rot_sigma, trans_sigma);
@@ -179,41 +180,41 @@ Eigen::Matrix<double, 8, 8> sandwich_covariance(const std::vector<MotionPair>& p
     if (!outlier[k]) in.push_back(k);
   }
   std::vector<Vec6> r(in.size());
-  std::vector<Mat67> J(in.size());
-  Mat7 H = Mat7::Zero();
+  std::vector<Mat68> J(in.size());
+  Mat8 H = Mat8::Zero();
   const double h = 1e-6;
   for (size_t n = 0; n < in.size(); ++n) {
     const MotionPair& p = pairs[in[n]];
-    r[n] = residual(p, Vec7::Zero());
+    r[n] = residual(p, Vec8::Zero());
     for (int c = 0; c < 8; ++c) {
-      Vec7 d = Vec7::Zero();
+      Vec8 d = Vec8::Zero();
       d[c] = h;
       J[n].col(c) = (residual(p, d) - residual(p, -d)) / (2 * h);
     }
     H += J[n].transpose() * J[n];
   }
   const size_t L = bartlett_window(pairs, in);
-  Mat7 S = Mat7::Zero();
+  Mat8 S = Mat8::Zero();
   for (size_t n = 0; n < in.size(); ++n) {
-    const Vec7 g = J[n].transpose() * r[n];
+    const Vec8 g = J[n].transpose() * r[n];
     S += g * g.transpose();
     for (size_t m = n + 1; m < in.size() && m <= n + L; ++m) {
       const double w = 1.0 - static_cast<double>(m - n) / (L + 1);
-      const Vec7 gm = J[m].transpose() * r[m];
+      const Vec8 gm = J[m].transpose() * r[m];
       S += w * (g * gm.transpose() + gm * g.transpose());
     }
   }
   // Held translation components and, when not estimated, the scale: stiff priors. A prior with
   // a sigma adds its information to H and, its whitened residual having unit variance, to S.
   for (const RefineOptions::Fixed& f : o.fixed) {
-    Vec7 a = Vec7::Zero();
+    Vec8 a = Vec8::Zero();
     a.segment<3>(3) = f.direction.normalized() / fixed_sigma(f);
     H += a * a.transpose();
     if (f.sigma_m > 0) S += a * a.transpose();
   }
   if (!o.estimate_scale) H(6, 6) += 1e18;
   if (!o.estimate_time_offset) H(7, 7) += 1e18;
-  const Mat7 Hinv = H.inverse();
+  const Mat8 Hinv = H.inverse();
   const double dof_correction =
       in.size() > 6 ? static_cast<double>(in.size()) / static_cast<double>(in.size() - 6) : 1.0;
   return dof_correction * Hinv * S * Hinv;
@@ -263,9 +264,7 @@ Refined solve(const std::vector<MotionPair>& pairs, const SE3& initial, double i
     out.pair_translation_residual_m.push_back(tr);
     z2s.push_back(std::pow(rr / rot_sigma, 2) + std::pow(tr / trans_sigma, 2));
   }
-  std::vector<double> sorted = z2s;
-  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-  const double level2 = std::max(1e-12, sorted[sorted.size() / 2] / 5.35);
+  const double level2 = std::max(1e-12, median(z2s) / 5.35);
   double ss = 0;
   size_t n_in = 0;
   for (double z2 : z2s) {
@@ -331,8 +330,7 @@ Trajectory smooth_poses(const Trajectory& in, double half_window_s) {
         d2.push_back(std::abs(in.T_world_body[k + 1].t[a] - 2 * in.T_world_body[k].t[a] +
                               in.T_world_body[k - 1].t[a]));
       }
-      std::nth_element(d2.begin(), d2.begin() + d2.size() / 2, d2.end());
-      noise += std::pow(1.4826 * d2[d2.size() / 2] / std::sqrt(6.0), 2);
+      noise += std::pow(1.4826 * median(d2) / std::sqrt(6.0), 2);
     }
   }
   const double cut = std::max(0.05, 5.0 * std::sqrt(noise));
@@ -425,12 +423,6 @@ std::vector<MotionPair> motion_pairs(const Trajectory& lidar, const Trajectory& 
 
 namespace {
 
-double median_of(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
-
 // Which pairs disagree with the consensus (closed_form's first step).
 std::vector<bool> consensus_outliers(const std::vector<MotionPair>& pairs) {
   const size_t n = pairs.size();
@@ -452,7 +444,7 @@ std::vector<bool> consensus_outliers(const std::vector<MotionPair>& pairs) {
     const Eigen::Matrix3d R = nearest_rotation(b[i] * a[i].transpose() + b[j] * a[j].transpose());
     res.clear();
     for (size_t k = 0; k < n; k += step) res.push_back((b[k] - R * a[k]).norm());
-    const double m = median_of(res);
+    const double m = median(res);
     if (m < best) best = m, best_R = R;
   }
   std::vector<bool> outlier(n, false);
@@ -479,7 +471,7 @@ std::vector<bool> consensus_outliers(const std::vector<MotionPair>& pairs) {
             .norm();
     if (!outlier[k]) inlier_e.push_back(e[k]);
   }
-  const double trans_cut = std::max(0.01, 3.0 * 1.4826 * median_of(inlier_e));
+  const double trans_cut = std::max(0.01, 3.0 * 1.4826 * median(inlier_e));
   for (size_t k = 0; k < n; ++k) outlier[k] = outlier[k] || e[k] > trans_cut;
   return outlier;
 }

@@ -12,6 +12,7 @@
 
 #include "rigcal/core/error.h"
 #include "rigcal/core/se3.h"
+#include "rigcal/core/stats.h"
 #include "rigcal/core/text.h"
 #include "rigcal/core/time.h"
 #include "rigcal/io/files.h"
@@ -23,11 +24,6 @@ std::string lower(std::string_view s) {
   std::string out(trim(s));
   for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return out;
-}
-
-double median(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
 }
 
 // The header's column index of each name (first of its aliases), -1 when absent.

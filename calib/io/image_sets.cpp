@@ -72,20 +72,13 @@ StampedFolder read_stamped_folder(const fs::path& folder, const std::string& ext
   out.files = glob_files((folder / "data" / ("*" + extension)).string());
   const fs::path stamps = folder / "timestamps.txt";
   const std::string text = read_text_file(stamps);
-  size_t pos = 0;
-  int line = 0;
-  while (pos < text.size()) {
-    const size_t end = std::min(text.find('\n', pos), text.size());
-    ++line;
-    const std::string_view s = trim(std::string_view(text).substr(pos, end - pos));
-    if (!s.empty()) {
-      try {
-        out.stamps.push_back(parse_time(s));
-      } catch (const Error&) {
-        fail_at(stamps.string(), line, "", fmt::format("expected a time, got '{}'", s));
-      }
+  for (const TextLine& line : data_lines(text, nullptr)) {
+    try {
+      out.stamps.push_back(parse_time(line.text));
+    } catch (const Error&) {
+      fail_at(stamps.string(), line.number, "",
+              fmt::format("expected a time, got '{}'", line.text));
     }
-    pos = end + 1;
   }
   if (out.stamps.size() != out.files.size()) {
     throw Error(fmt::format("{}: {} stamps in timestamps.txt for {} {} files in data/",

@@ -11,6 +11,7 @@
 
 #include "rigcal/core/error.h"
 #include "rigcal/core/text.h"
+#include "rigcal/io/files.h"
 
 namespace rigcal::io {
 namespace {
@@ -69,10 +70,9 @@ double field_value(const char* record, const Field& f) {
 std::vector<Field> vbr_fields(const std::filesystem::path& bin, size_t& point_step) {
   const std::filesystem::path meta = bin.parent_path().parent_path() / ".metadata.json";
   if (!std::filesystem::exists(meta)) return {};
-  std::ifstream in(meta);
   nlohmann::json j;
   try {
-    j = nlohmann::json::parse(in);
+    j = nlohmann::json::parse(read_text_file(meta));
   } catch (const std::exception& e) {
     throw Error(fmt::format("{}: not JSON ({})", meta.string(), e.what()));
   }
@@ -99,10 +99,9 @@ std::vector<Field> vbr_fields(const std::filesystem::path& bin, size_t& point_st
   return fields;
 }
 
-std::vector<Eigen::Vector3d> read_kitti_bin(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(fmt::format("{}: cannot open", path.string()));
-  const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+// KITTI points, or vbr-devkit's full records where its metadata describes them.
+std::vector<Eigen::Vector3d> read_bin(const std::filesystem::path& path) {
+  const std::string data = read_text_file(path);  // binary-safe: one read of the whole file
   size_t step = 16;
   const std::vector<Field> fields = vbr_fields(path, step);
   auto find = [&](const char* name) -> const Field* {
@@ -258,7 +257,7 @@ std::vector<Eigen::Vector3d> read_pcd(const std::filesystem::path& path) {
 
 std::vector<Eigen::Vector3d> read_point_cloud(const std::filesystem::path& path) {
   const std::string ext = path.extension().string();
-  if (ext == ".bin") return read_kitti_bin(path);
+  if (ext == ".bin") return read_bin(path);
   if (ext == ".pcd") return read_pcd(path);
   throw Error(fmt::format("{}: unknown point cloud extension (.bin or .pcd)", path.string()));
 }

@@ -63,20 +63,23 @@ Plane fit_plane_along_rays(const std::vector<Eigen::Vector3d>& points, double* r
     for (size_t i = 0; i < points.size(); ++i) r[i] = range_residual(n, d, points[i]);
     return r;
   };
-  Eigen::MatrixXd J(points.size(), 3);
-  Eigen::Matrix3d JtJ = Eigen::Matrix3d::Identity();
+  // The residuals' Jacobian at `plane` (forward differences, in the tangent basis of its n).
+  auto jacobian = [&](const Eigen::VectorXd& r) {
+    const Eigen::Matrix<double, 3, 2> B = tangent(plane.n);
+    Eigen::MatrixXd J(points.size(), 3);
+    for (int c = 0; c < 3; ++c) {
+      Eigen::Vector3d dp = Eigen::Vector3d::Zero();
+      dp[c] = 1e-7;
+      const Eigen::Vector3d n1 = (plane.n + B * dp.head<2>()).normalized();
+      J.col(c) = (residuals(n1, plane.d + dp[2]) - r) / 1e-7;
+    }
+    return J;
+  };
   for (int it = 0; it < 10; ++it) {
     const Eigen::Matrix<double, 3, 2> B = tangent(plane.n);
     const Eigen::VectorXd r = residuals(plane.n, plane.d);
-    const double h = 1e-7;
-    for (int c = 0; c < 3; ++c) {
-      Eigen::Vector3d dp = Eigen::Vector3d::Zero();
-      dp[c] = h;
-      const Eigen::Vector3d n1 = (plane.n + B * dp.head<2>()).normalized();
-      J.col(c) = (residuals(n1, plane.d + dp[2]) - r) / h;
-    }
-    JtJ = J.transpose() * J;
-    const Eigen::Vector3d step = JtJ.ldlt().solve(-J.transpose() * r);
+    const Eigen::MatrixXd J = jacobian(r);
+    const Eigen::Vector3d step = (J.transpose() * J).ldlt().solve(-J.transpose() * r);
     plane.n = (plane.n + B * step.head<2>()).normalized();
     plane.d += step[2];
     if (step.norm() < 1e-12) break;
@@ -87,13 +90,7 @@ Plane fit_plane_along_rays(const std::vector<Eigen::Vector3d>& points, double* r
   const double var = r.squaredNorm() / std::max(1.0, N - 3.0);
   if (rms) *rms = std::sqrt(r.squaredNorm() / N);
   // J at the solution, in the tangent basis of the final n (the covariance's convention).
-  const Eigen::Matrix<double, 3, 2> B = tangent(plane.n);
-  for (int c = 0; c < 3; ++c) {
-    Eigen::Vector3d dp = Eigen::Vector3d::Zero();
-    dp[c] = 1e-7;
-    const Eigen::Vector3d n1 = (plane.n + B * dp.head<2>()).normalized();
-    J.col(c) = (residuals(n1, plane.d + dp[2]) - r) / 1e-7;
-  }
+  const Eigen::MatrixXd J = jacobian(r);
   plane.covariance = var * (J.transpose() * J).inverse();
   return plane;
 }

@@ -14,26 +14,8 @@ namespace {
 
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 
-// The residual of one pair at T (camera plane's tangent angles and distance) and its covariance.
-Eigen::Vector3d residual(const BoardPair& p, const SE3& T) {
-  const Eigen::Vector3d n = T.R * p.lidar.n;
-  const Eigen::Matrix<double, 3, 2> Bc = tangent(p.camera.n);
-  Eigen::Vector3d r;
-  r.head<2>() = Bc.transpose() * n;
-  r[2] = p.camera.d - (p.lidar.d + n.dot(T.t));
-  return r;
-}
-
-Eigen::Matrix3d residual_covariance(const BoardPair& p, const SE3& T) {
-  const Eigen::Matrix<double, 3, 2> Bc = tangent(p.camera.n), Bl = tangent(p.lidar.n);
-  Eigen::Matrix3d Jl = Eigen::Matrix3d::Zero();
-  Jl.block<2, 2>(0, 0) = Bc.transpose() * T.R * Bl;
-  Jl.block<1, 2>(2, 0) = -T.t.transpose() * T.R * Bl;
-  Jl(2, 2) = -1.0;
-  return p.camera.covariance + Jl * p.lidar.covariance * Jl.transpose();
-}
-
-// residual() for Ceres: the extrinsic is (exp(dr) R0, t0 + dt), the residual whitened by W.
+// One pair's residual, the camera plane's tangent angles and distance against the LiDAR plane
+// carried over by (exp(dr) R0, t0 + dt), whitened by W (for Ceres; residual() below in double).
 struct PlaneError {
   Eigen::Matrix3d W, R0;
   Eigen::Vector3d t0, n_lidar;
@@ -54,6 +36,27 @@ struct PlaneError {
     return true;
   }
 };
+
+PlaneError plane_error(const BoardPair& p, const SE3& T, const Eigen::Matrix3d& W) {
+  return {W, T.R, T.t, p.lidar.n, tangent(p.camera.n), p.camera.d, p.lidar.d};
+}
+
+// The residual of one pair at T, unwhitened, and its covariance.
+Eigen::Vector3d residual(const BoardPair& p, const SE3& T) {
+  const double zero[3] = {0, 0, 0};
+  Eigen::Vector3d r;
+  plane_error(p, T, Eigen::Matrix3d::Identity())(zero, zero, r.data());
+  return r;
+}
+
+Eigen::Matrix3d residual_covariance(const BoardPair& p, const SE3& T) {
+  const Eigen::Matrix<double, 3, 2> Bc = tangent(p.camera.n), Bl = tangent(p.lidar.n);
+  Eigen::Matrix3d Jl = Eigen::Matrix3d::Zero();
+  Jl.block<2, 2>(0, 0) = Bc.transpose() * T.R * Bl;
+  Jl.block<1, 2>(2, 0) = -T.t.transpose() * T.R * Bl;
+  Jl(2, 2) = -1.0;
+  return p.camera.covariance + Jl * p.lidar.covariance * Jl.transpose();
+}
 
 }  // namespace
 
@@ -135,9 +138,8 @@ Solution solve(const std::vector<BoardPair>& pairs, double huber) {
     double dr[3] = {0, 0, 0}, dt[3] = {0, 0, 0};
     ceres::Problem problem;
     for (size_t k = 0; k < pairs.size(); ++k) {
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PlaneError, 3, 3, 3>(new PlaneError{
-                                   W[k], T.R, T.t, pairs[k].lidar.n, tangent(pairs[k].camera.n),
-                                   pairs[k].camera.d, pairs[k].lidar.d}),
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PlaneError, 3, 3, 3>(
+                                   new PlaneError(plane_error(pairs[k], T, W[k]))),
                                new ceres::HuberLoss(huber), dr, dt);
     }
     ceres::Solver::Options options;

@@ -8,14 +8,15 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <climits>
-#include <cstdint>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <opencv2/core.hpp>
 #include <optional>
 
 #include "rigcal/core/error.h"
 #include "rigcal/core/se3.h"
+#include "rigcal/core/stats.h"
 
 namespace rigcal::time_sync {
 namespace {
@@ -29,13 +30,6 @@ struct Series {
   double median_dt = 0.0, gap_s = 0.0, averaging_s = 0.0;
   double rate_hz() const { return 1.0 / median_dt; }
 };
-
-double median(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  const size_t n = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + n, v.end());
-  return v[n];
-}
 
 // Finite-difference tangents: central where both neighbours are within gap_s, one-sided next to a
 // gap or an end (so a segment beside a gap is interpolated with its secant there).
