@@ -2,6 +2,7 @@
 #include "rigcal/hand_eye/hand_eye.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <cmath>
 #include <memory>
@@ -25,7 +26,8 @@ struct Options {
   std::string duplicates = "error", attitude;
   std::vector<std::string> fix;    // AXIS=VALUE, GNSS/INS frame
   std::vector<std::string> prior;  // AXIS=VALUE,SIGMA
-  double spacing_s = 1.0, stride_s = 0.1, min_rotation_deg = 1.0, rotation_sigma_deg = 0.05,
+  std::vector<double> spacings_s = hand_eye::PairOptions{}.spacings_s;
+  double stride_s = 0.1, min_rotation_deg = 1.0, rotation_sigma_deg = 0.05,
          translation_sigma_m = 0.02, max_sigma_m = 0.05, gnss_smoothing_s = 0.05;
   bool estimate_offset = false;
 };
@@ -134,7 +136,7 @@ void run(const Options& o) {
         offset_s));
   }
   hand_eye::PairOptions po;
-  po.spacing_s = o.spacing_s;
+  po.spacings_s = o.spacings_s;
   po.stride_s = o.stride_s;
   po.min_rotation_deg = o.min_rotation_deg;
   po.time_offset_s = offset_s;
@@ -144,7 +146,7 @@ void run(const Options& o) {
     throw Error(fmt::format(
         "{} motion pairs of {} s rotating at least {} deg: too few or too small motions (at least "
         "3 are needed; rotate the rig about changing axes, or lower --min-rotation)",
-        pairs.size(), o.spacing_s, o.min_rotation_deg));
+        pairs.size(), fmt::join(o.spacings_s, " and "), o.min_rotation_deg));
   }
   const hand_eye::ClosedForm cf = hand_eye::closed_form(pairs, o.max_sigma_m);
   const hand_eye::Observability& ob = cf.observability;
@@ -215,10 +217,15 @@ void run(const Options& o) {
   for (bool b : r.outlier) outliers += b;
 
   fmt::print(
-      "{} motion pairs of {} s every {} s (LiDAR {} poses, GNSS/INS {} poses); {} left out of the "
+      "{} motion pairs of {} s, {} (LiDAR {} poses, GNSS/INS {} poses); {} left out of the "
       "closed form by the consensus\n",
-      pairs.size(), o.spacing_s, o.stride_s > 0 ? o.stride_s : o.spacing_s, lidar.size(),
-      gnss.size(), cf.rejected);
+      pairs.size(), fmt::join(o.spacings_s, " and "),
+      o.stride_s > 0 ? fmt::format("each length every {} s", o.stride_s) : "end to end",
+      lidar.size(), gnss.size(), cf.rejected);
+  for (const hand_eye::Refined::PairNoise& n : r.pair_noise) {
+    fmt::print("pairs of {:.2f} s: {} inliers, noise {:.4f} deg and {:.4f} m per component\n",
+               n.length_s, n.pairs, n.rotation_deg, n.translation_m);
+  }
   fmt::print(
       "observability: rotation singular values {:.3f} {:.3f} {:.3f} rad; translation 1-sigma along "
       "its principal directions {:.4f} {:.4f} {:.4f} m\n",
@@ -237,7 +244,7 @@ void run(const Options& o) {
   std::vector<io::OutputFile> files;
   if (!o.report.empty()) {
     io::HandEyeInputs in{
-        o.lidar,       o.gnss, o.rig, offset_s, o.spacing_s, o.stride_s, o.min_rotation_deg,
+        o.lidar,       o.gnss, o.rig, offset_s, o.spacings_s, o.stride_s, o.min_rotation_deg,
         o.max_sigma_m, notes};
     files = io::hand_eye_report_files(o.report, in, pairs, cf, r, lidar, gnss);
   }
@@ -292,7 +299,11 @@ void add_hand_eye(CLI::App& app) {
   cmd->add_flag("--estimate-offset", o->estimate_offset,
                 "estimate the clock offset from the trajectories' angular velocities (around "
                 "the rig's value, +-1 s) and write it as the sensor's time_offset");
-  cmd->add_option("--spacing", o->spacing_s, "seconds between a pair's two poses")
+  cmd->add_option("--spacing", o->spacings_s,
+                  "seconds between a pair's two poses; several lengths comma-separated, each "
+                  "weighed with its own noise level (default 0.3,1: short pairs catch a hand-held "
+                  "rig's sway, 1 s pairs its turns)")
+      ->delimiter(',')
       ->capture_default_str();
   cmd->add_option("--stride", o->stride_s,
                   "seconds between the starts of consecutive pairs (0: end to end); overlapping "

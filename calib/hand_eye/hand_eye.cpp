@@ -8,6 +8,7 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <optional>
 #include <random>
 
@@ -160,16 +161,17 @@ size_t bartlett_window(const std::vector<MotionPair>& pairs, const std::vector<s
 Eigen::Matrix<double, 8, 8> sandwich_covariance(const std::vector<MotionPair>& pairs, const SE3& X,
                                                 double scale, double dt,
                                                 const std::vector<bool>& outlier,
-                                                const RefineOptions& o, double rot_sigma,
-                                                double trans_sigma) {
+                                                const RefineOptions& o,
+                                                const std::vector<double>& rot_sigma,
+                                                const std::vector<double>& trans_sigma) {
   using Vec6 = Eigen::Matrix<double, 6, 1>;
   using Vec8 = Eigen::Matrix<double, 8, 1>;
   using Mat68 = Eigen::Matrix<double, 6, 8>;
   using Mat8 = Eigen::Matrix<double, 8, 8>;
-  auto residual = [&](const MotionPair& p, const Vec8& d) {
+  auto residual = [&](size_t k, const Vec8& d) {
     const SE3 Xd = perturbed(X, d.head<6>());
     const double sd = scale + d[6], dtd = dt + d[7];
-    const PairError e = pair_error(p, rot_sigma, trans_sigma);
+    const PairError e = pair_error(pairs[k], rot_sigma[k], trans_sigma[k]);
     const Eigen::Quaterniond q = Xd.quaternion();
     Vec6 r;
     e(q.coeffs().data(), Xd.t.data(), &sd, &dtd, r.data());
@@ -181,29 +183,39 @@ Eigen::Matrix<double, 8, 8> sandwich_covariance(const std::vector<MotionPair>& p
   }
   std::vector<Vec6> r(in.size());
   std::vector<Mat68> J(in.size());
-  Mat8 H = Mat8::Zero();
   const double h = 1e-6;
-  for (size_t n = 0; n < in.size(); ++n) {
-    const MotionPair& p = pairs[in[n]];
-    r[n] = residual(p, Vec8::Zero());
+  tbb::parallel_for(size_t{0}, in.size(), [&](size_t n) {
+    r[n] = residual(in[n], Vec8::Zero());
     for (int c = 0; c < 8; ++c) {
       Vec8 d = Vec8::Zero();
       d[c] = h;
-      J[n].col(c) = (residual(p, d) - residual(p, -d)) / (2 * h);
+      J[n].col(c) = (residual(in[n], d) - residual(in[n], -d)) / (2 * h);
     }
-    H += J[n].transpose() * J[n];
-  }
+  });
+  Mat8 H = Mat8::Zero();
+  for (size_t n = 0; n < in.size(); ++n) H += J[n].transpose() * J[n];
+  // S = sum over n, m of w(m - n) g_n g_m^T, g = J^T r. The Bartlett weight (L + 1 - |k|) / (L + 1)
+  // counts the (i, j) in [0, L]^2 with i - j = k, so sum_m w(m - n) g_m is a moving sum of L + 1
+  // forward, then L + 1 backward, over L + 1: linear in the number of pairs, not in L times it.
   const size_t L = bartlett_window(pairs, in);
-  Mat8 S = Mat8::Zero();
-  for (size_t n = 0; n < in.size(); ++n) {
-    const Vec8 g = J[n].transpose() * r[n];
-    S += g * g.transpose();
-    for (size_t m = n + 1; m < in.size() && m <= n + L; ++m) {
-      const double w = 1.0 - static_cast<double>(m - n) / (L + 1);
-      const Vec8 gm = J[m].transpose() * r[m];
-      S += w * (g * gm.transpose() + gm * g.transpose());
-    }
+  const long N = static_cast<long>(in.size()), W = static_cast<long>(L) + 1;
+  std::vector<Vec8> g(in.size());
+  for (long n = 0; n < N; ++n) g[n] = J[n].transpose() * r[n];
+  std::vector<Vec8> c(N + W, Vec8::Zero());  // c[n + W] = sum_{i=0}^{L} g[n + i], n in [-W, N)
+  Vec8 run = Vec8::Zero();
+  for (long n = N - 1; n >= -W; --n) {
+    if (n >= 0) run += g[n];
+    if (n + W < N) run -= g[n + W];
+    c[n + W] = run;
   }
+  Mat8 S = Mat8::Zero();
+  run.setZero();
+  for (long n = -W; n < N; ++n) {
+    run += c[n + W];  // sum_{j=0}^{L} c[n - j]
+    if (n - W >= -W) run -= c[n - W + W];
+    if (n >= 0) S += g[n] * run.transpose() / static_cast<double>(W);
+  }
+  S = 0.5 * (S + S.transpose());
   // Held translation components and, when not estimated, the scale: stiff priors. A prior with
   // a sigma adds its information to H and, its whitened residual having unit variance, to S.
   for (const RefineOptions::Fixed& f : o.fixed) {
@@ -220,16 +232,18 @@ Eigen::Matrix<double, 8, 8> sandwich_covariance(const std::vector<MotionPair>& p
   return dof_correction * Hinv * S * Hinv;
 }
 
-// One robust solve with the given per-pair sigmas (rad, m), its residuals, outliers and covariance.
+// One robust solve with the given per-pair sigmas (rad, m) on every `step`-th pair, then every
+// pair's residuals, the outliers and (when asked) the covariance.
 Refined solve(const std::vector<MotionPair>& pairs, const SE3& initial, double initial_scale,
-              double initial_dt, const RefineOptions& o, double rot_sigma, double trans_sigma) {
+              double initial_dt, const RefineOptions& o, const std::vector<double>& rot_sigma,
+              const std::vector<double>& trans_sigma, bool with_covariance, size_t step = 1) {
   Eigen::Quaterniond q = initial.quaternion();
   Eigen::Vector3d t = initial.t;
   double scale = initial_scale, dt = initial_dt;
   ceres::Problem problem;
-  for (const MotionPair& p : pairs) {
+  for (size_t k = 0; k < pairs.size(); k += step) {
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PairError, 6, 4, 3, 1, 1>(
-                                 new PairError(pair_error(p, rot_sigma, trans_sigma))),
+                                 new PairError(pair_error(pairs[k], rot_sigma[k], trans_sigma[k]))),
                              new ceres::HuberLoss(o.huber), q.coeffs().data(), t.data(), &scale,
                              &dt);
   }
@@ -242,9 +256,9 @@ Refined solve(const std::vector<MotionPair>& pairs, const SE3& initial, double i
   if (!o.estimate_scale) problem.SetParameterBlockConstant(&scale);
   if (!o.estimate_time_offset) problem.SetParameterBlockConstant(&dt);
   ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_QR;
+  so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   so.max_num_iterations = 100;
-  so.num_threads = 1;
+  so.num_threads = 2;
   ceres::Solver::Summary summary;
   ceres::Solve(so, &problem, &summary);
 
@@ -256,13 +270,14 @@ Refined solve(const std::vector<MotionPair>& pairs, const SE3& initial, double i
   // chi-square with 6 dof (22.46), after scaling the sigmas by the residuals' own level (the
   // median of chi-square(6) is 5.35), so that sigmas set too small do not flag every pair.
   std::vector<double> z2s;
-  for (const MotionPair& p : pairs) {
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    const MotionPair& p = pairs[k];
     const SE3 A = shifted_motion(p, dt);
     const double rr = rotation_angle((X.R * A.R).transpose() * (p.B.R * X.R));
     const double tr = (p.B.R * X.t + p.B.t - X.R * (scale * A.t) - X.t).norm();
     out.pair_rotation_residual_deg.push_back(rr * 180.0 / M_PI);
     out.pair_translation_residual_m.push_back(tr);
-    z2s.push_back(std::pow(rr / rot_sigma, 2) + std::pow(tr / trans_sigma, 2));
+    z2s.push_back(std::pow(rr / rot_sigma[k], 2) + std::pow(tr / trans_sigma[k], 2));
   }
   const double level2 = std::max(1e-12, median(z2s) / 5.35);
   double ss = 0;
@@ -275,19 +290,33 @@ Refined solve(const std::vector<MotionPair>& pairs, const SE3& initial, double i
   const double dof =
       std::max(1.0, 6.0 * static_cast<double>(n_in) - 6.0 + static_cast<double>(o.fixed.size()));
   out.noise_scale = std::sqrt(ss / dof);
+  out.time_offset_correction_s = dt;
+  if (!with_covariance) return out;
   const Eigen::Matrix<double, 8, 8> C =
       sandwich_covariance(pairs, X, scale, dt, out.outlier, o, rot_sigma, trans_sigma);
   out.covariance = C.topLeftCorner<6, 6>();
   out.odometry_scale_sigma = o.estimate_scale ? std::sqrt(std::max(0.0, C(6, 6))) : 0.0;
-  out.time_offset_correction_s = dt;
   out.time_offset_sigma_s = o.estimate_time_offset ? std::sqrt(std::max(0.0, C(7, 7))) : 0.0;
   for (int i = 0; i < 3; ++i) {
     out.rotation_sigma_deg[i] = std::sqrt(std::max(0.0, out.covariance(i, i))) * 180.0 / M_PI;
     out.translation_sigma_m[i] = std::sqrt(std::max(0.0, out.covariance(3 + i, 3 + i)));
   }
-  out.pair_rotation_noise_deg = rot_sigma * 180.0 / M_PI;
-  out.pair_translation_noise_m = trans_sigma;
   return out;
+}
+
+// Pairs grouped by length: sorted by t1 - t0, a new group where two consecutive lengths differ by
+// more than 50 ms. Returns each pair's group and the number of groups.
+std::pair<std::vector<size_t>, size_t> length_groups(const std::vector<MotionPair>& pairs) {
+  std::vector<size_t> order(pairs.size()), group(pairs.size(), 0);
+  std::iota(order.begin(), order.end(), size_t{0});
+  auto length = [&](size_t k) { return (pairs[k].t1 - pairs[k].t0).seconds(); };
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return length(a) < length(b); });
+  size_t g = 0;
+  for (size_t n = 1; n < order.size(); ++n) {
+    if (length(order[n]) - length(order[n - 1]) > 0.05) ++g;
+    group[order[n]] = g;
+  }
+  return {group, pairs.empty() ? 0 : g + 1};
 }
 
 }  // namespace
@@ -295,24 +324,50 @@ Refined solve(const std::vector<MotionPair>& pairs, const SE3& initial, double i
 Refined refine(const std::vector<MotionPair>& pairs, const SE3& initial, const RefineOptions& o) {
   if (pairs.size() < 3)
     throw Error(fmt::format("{} motion pairs; at least 3 are needed", pairs.size()));
-  const Refined first = solve(pairs, initial, 1.0, 0.0, o, o.rotation_sigma_deg * M_PI / 180.0,
-                              o.translation_sigma_m);
+  const std::vector<double> given_rot(pairs.size(), o.rotation_sigma_deg * M_PI / 180.0),
+      given_trans(pairs.size(), o.translation_sigma_m);
+  // The first solve gives the noise levels and a start: on at most 5,000 pairs spread over the
+  // set (its residuals on all of them); the second weighs all pairs with those levels.
+  const Refined first = solve(pairs, initial, 1.0, 0.0, o, given_rot, given_trans, false,
+                              std::max<size_t>(1, pairs.size() / 5000));
+  // Where the residuals give no noise levels, the first solve is the answer.
+  auto with_given_sigmas = [&] {
+    return solve(pairs, initial, 1.0, 0.0, o, given_rot, given_trans, true);
+  };
   // The two noise levels from the inlier residuals (RMS per component: a rotation residual has 3,
   // a translation residual 3), then solved again with them: a single scale on the given sigmas
-  // would let a noisy rotation inflate the translation's covariance, or the reverse.
-  double rr2 = 0, tr2 = 0;
-  size_t n = 0;
+  // would let a noisy rotation inflate the translation's covariance, or the reverse. Each pair
+  // length has its own levels (fewer than 10 inliers: all lengths' levels together).
+  const auto [group, groups] = length_groups(pairs);
+  std::vector<double> rr2(groups + 1, 0.0), tr2(groups + 1, 0.0), len(groups + 1, 0.0);
+  std::vector<size_t> n(groups + 1, 0);
+  std::vector<std::vector<double>> lengths(groups);
   for (size_t k = 0; k < pairs.size(); ++k) {
     if (first.outlier[k]) continue;
-    rr2 += std::pow(first.pair_rotation_residual_deg[k] * M_PI / 180.0, 2);
-    tr2 += std::pow(first.pair_translation_residual_m[k], 2);
-    ++n;
+    const double r2 = std::pow(first.pair_rotation_residual_deg[k] * M_PI / 180.0, 2);
+    const double t2 = std::pow(first.pair_translation_residual_m[k], 2);
+    for (size_t g : {group[k], groups}) rr2[g] += r2, tr2[g] += t2, ++n[g];
+    lengths[group[k]].push_back((pairs[k].t1 - pairs[k].t0).seconds());
   }
-  if (n < 3) return first;
-  const double rot_noise = std::sqrt(rr2 / (3.0 * n)), trans_noise = std::sqrt(tr2 / (3.0 * n));
-  if (!(rot_noise > 1e-12 && trans_noise > 1e-12)) return first;
-  return solve(pairs, first.T_gnss_lidar, first.odometry_scale, first.time_offset_correction_s, o,
-               rot_noise, trans_noise);
+  if (n[groups] < 3) return with_given_sigmas();
+  std::vector<double> rot_noise(groups + 1), trans_noise(groups + 1);
+  for (size_t g = 0; g <= groups; ++g) {
+    const size_t own = n[g] >= 10 ? g : groups;
+    rot_noise[g] = std::sqrt(rr2[own] / (3.0 * n[own]));
+    trans_noise[g] = std::sqrt(tr2[own] / (3.0 * n[own]));
+    if (!(rot_noise[g] > 1e-12 && trans_noise[g] > 1e-12)) return with_given_sigmas();
+  }
+  std::vector<double> rot_sigma(pairs.size()), trans_sigma(pairs.size());
+  for (size_t k = 0; k < pairs.size(); ++k)
+    rot_sigma[k] = rot_noise[group[k]], trans_sigma[k] = trans_noise[group[k]];
+  Refined out = solve(pairs, first.T_gnss_lidar, first.odometry_scale,
+                      first.time_offset_correction_s, o, rot_sigma, trans_sigma, true);
+  for (size_t g = 0; g < groups; ++g) {
+    if (n[g] == 0) continue;
+    out.pair_noise.push_back(
+        {median(lengths[g]), n[g], rot_noise[g] * 180.0 / M_PI, trans_noise[g]});
+  }
+  return out;
 }
 
 Trajectory smooth_poses(const Trajectory& in, double half_window_s) {
@@ -387,12 +442,13 @@ Trajectory smooth_poses(const Trajectory& in, double half_window_s) {
   return out;
 }
 
-std::vector<MotionPair> motion_pairs(const Trajectory& lidar, const Trajectory& raw_gnss,
-                                     const PairOptions& o) {
-  const Trajectory gnss = smooth_poses(raw_gnss, o.gnss_half_window_s);
-  std::vector<MotionPair> pairs;
+namespace {
+
+// The pairs of one length along the smoothed GNSS/INS trajectory (motion_pairs).
+void pairs_of_length(const Trajectory& lidar, const Trajectory& gnss, const PairOptions& o,
+                     double spacing_s, std::vector<MotionPair>& pairs) {
   const Time offset = Time::from_seconds(o.time_offset_s);
-  const Time spacing = Time::from_seconds(o.spacing_s), max_gap = Time::from_seconds(o.max_gap_s);
+  const Time spacing = Time::from_seconds(spacing_s), max_gap = Time::from_seconds(o.max_gap_s);
   const Time stride = o.stride_s > 0 ? Time::from_seconds(o.stride_s) : spacing;
   const double min_rotation = o.min_rotation_deg * M_PI / 180.0;
   size_t i = 0;
@@ -418,6 +474,21 @@ std::vector<MotionPair> motion_pairs(const Trajectory& lidar, const Trajectory& 
                                                    gnss.stamps[i] + stride) -
                                   gnss.stamps.begin());
   }
+}
+
+}  // namespace
+
+std::vector<MotionPair> motion_pairs(const Trajectory& lidar, const Trajectory& raw_gnss,
+                                     const PairOptions& o) {
+  for (double s : o.spacings_s) {
+    if (!(s > 0)) throw Error(fmt::format("pair spacing {} s: must be positive", s));
+  }
+  const Trajectory gnss = smooth_poses(raw_gnss, o.gnss_half_window_s);
+  std::vector<MotionPair> pairs;
+  for (double s : o.spacings_s) pairs_of_length(lidar, gnss, o, s, pairs);
+  std::stable_sort(pairs.begin(), pairs.end(), [](const MotionPair& a, const MotionPair& b) {
+    return a.t0 < b.t0 || (a.t0 == b.t0 && a.t1 < b.t1);
+  });
   return pairs;
 }
 

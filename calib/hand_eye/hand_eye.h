@@ -32,10 +32,14 @@ struct MotionPair {
 };
 
 struct PairOptions {
-  double spacing_s = 1.0;  // t1 - t0
-  // Between the starts of consecutive pairs; 0: spacing_s (pairs end to end). Overlapping pairs
-  // use more of the data (every 0.1 s: every LiDAR pose); the covariance does not count them as
-  // independent (refine's sandwich estimator).
+  // t1 - t0: pairs of each of these lengths. A hand-held rig's rotation grows slower than the
+  // spacing (its sway and shake: 0.3 s pairs of the VBR walks turn 55-70 % as much as 1 s pairs)
+  // while the odometry's noise grows as its square root, so short pairs add information that 1 s
+  // pairs miss, and 1 s pairs hold the slower turns (doc/hand-eye.md, "Pair lengths").
+  std::vector<double> spacings_s = {0.3, 1.0};
+  // Between the starts of consecutive pairs of one length; 0: the length (pairs end to end).
+  // Overlapping pairs use more of the data (every 0.1 s: every LiDAR pose); the covariance does
+  // not count them as independent (refine's sandwich estimator).
   double stride_s = 0.1;
   double min_rotation_deg = 1.0;  // pairs whose GNSS/INS rotation is smaller are dropped
   // The GNSS/INS clock: t_lidar = t_gnss + time_offset_s (its time_offset in the rig when the
@@ -58,10 +62,10 @@ struct PairOptions {
 // is followed to 0.2 mm by +-0.05 s.
 Trajectory smooth_poses(const Trajectory& trajectory, double half_window_s);
 
-// Pairs along the GNSS/INS trajectory (smoothed, options.gnss_half_window_s): a GNSS/INS pose at
-// t0, the first one at least spacing_s later at t1, the LiDAR odometry interpolated (slerp +
-// linear) at both instants. Pairs outside the odometry, across a gap, or rotating too little are
-// skipped.
+// Pairs along the GNSS/INS trajectory (smoothed, options.gnss_half_window_s): for each spacing, a
+// GNSS/INS pose at t0, the first one at least the spacing later at t1, the LiDAR odometry
+// interpolated (slerp + linear) at both instants. Pairs outside the odometry, across a gap, or
+// rotating too little are skipped. In order of t0 (then t1).
 std::vector<MotionPair> motion_pairs(const Trajectory& T_odom_lidar, const Trajectory& T_enu_gnss,
                                      const PairOptions& options = {});
 
@@ -160,9 +164,16 @@ struct Refined {
   std::vector<double> pair_rotation_residual_deg, pair_translation_residual_m;
   std::vector<bool> outlier;  // beyond the 99.9 % of chi-square(6) at the residuals' level
   double noise_scale = 1.0;   // RMS of the normalized residuals: the sigmas' correction factor
-  // The per-pair noise levels the final solve used: estimated from the first solve's inlier
-  // residuals (RMS per component), the given sigmas serving only as a start.
-  double pair_rotation_noise_deg = 0.0, pair_translation_noise_m = 0.0;
+  // The noise levels the final solve weighed the pairs with, one per pair length (spacing):
+  // estimated from the first solve's inlier residuals (RMS per component), the given sigmas
+  // serving only as a start. Lengths differ in noise: the GNSS/INS's is the same at any length,
+  // the odometry's grows with it.
+  struct PairNoise {
+    double length_s = 0;  // the group's median t1 - t0
+    size_t pairs = 0;     // its inliers
+    double rotation_deg = 0, translation_m = 0;
+  };
+  std::vector<PairNoise> pair_noise;
   // The odometry's scale correction (GNSS/INS distance over LiDAR distance) and its 1-sigma;
   // 1 and 0 when not estimated.
   double odometry_scale = 1.0, odometry_scale_sigma = 0.0;
@@ -182,7 +193,8 @@ Held hold_unobservable(const Observability& observability, const std::optional<S
 
 // Nonlinear least squares over X from `initial` (Ceres, Huber loss): all pairs' rotation and
 // translation residuals together, unlike the closed form's two separate steps. Solved twice: with
-// the given sigmas, then with the rotation and translation noise levels the residuals show.
+// the given sigmas, then with the rotation and translation noise levels the residuals show, for
+// each pair length apart (pairs whose lengths differ by more than 50 ms).
 Refined refine(const std::vector<MotionPair>& pairs, const SE3& initial,
                const RefineOptions& options = {});
 

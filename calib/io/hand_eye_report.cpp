@@ -35,7 +35,7 @@ std::vector<OutputFile> hand_eye_report_files(const std::filesystem::path& dir,
                  {"gnss", in.gnss},
                  {"rig", in.rig},
                  {"gnss_time_offset_s", in.gnss_time_offset_s},
-                 {"spacing_s", in.spacing_s},
+                 {"spacings_s", in.spacings_s},
                  {"stride_s", in.stride_s},
                  {"min_rotation_deg", in.min_rotation_deg}};
   j["T_gnss_lidar"] = {{"t_m", vec(X.t)},
@@ -73,12 +73,18 @@ std::vector<OutputFile> hand_eye_report_files(const std::filesystem::path& dir,
        "distance over odometry distance)"},
       {"value", r.odometry_scale},
       {"sigma", r.odometry_scale_sigma}};
+  nlohmann::json levels = nlohmann::json::array();
+  for (const hand_eye::Refined::PairNoise& n : r.pair_noise) {
+    levels.push_back({{"length_s", n.length_s},
+                      {"pairs", n.pairs},
+                      {"rotation_deg", n.rotation_deg},
+                      {"translation_m", n.translation_m}});
+  }
   j["pair_noise"] = {
       {"definition",
-       "RMS per component of the inlier pairs' residuals after a first solve with the given "
-       "sigmas; the final solve weighs the pairs with these"},
-      {"rotation_deg", r.pair_rotation_noise_deg},
-      {"translation_m", r.pair_translation_noise_m}};
+       "per pair length: RMS per component of the inlier pairs' residuals after a first solve "
+       "with the given sigmas; the final solve weighs each pair with its length's levels"},
+      {"levels", levels}};
   j["notes"] = notes;
   nlohmann::json pj = nlohmann::json::array();
   for (size_t k = 0; k < pairs.size(); ++k) {

@@ -14,8 +14,9 @@ namespace rigcal::io {
 
 struct HandEyeInputs {
   std::string lidar, gnss, rig;  // paths as given
-  double gnss_time_offset_s = 0.0, spacing_s = 0.0, stride_s = 0.0, min_rotation_deg = 0.0,
-         max_sigma_m = 0.0;
+  double gnss_time_offset_s = 0.0;
+  std::vector<double> spacings_s;
+  double stride_s = 0.0, min_rotation_deg = 0.0, max_sigma_m = 0.0;
   std::vector<std::string> notes;
 };
 

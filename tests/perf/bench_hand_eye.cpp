@@ -53,6 +53,7 @@ void BM_OpenCvParkThreeHundredStations(benchmark::State& state) {
   hand_eye::PairOptions po;
   po.time_offset_s = in.offset_s;
   po.stride_s = 0;  // end to end: they chain into stations
+  po.spacings_s = {1.0};
   const auto pairs = hand_eye::motion_pairs(in.lidar, in.gnss, po);
   std::vector<cv::Mat> Rg, tg, Rc, tc;
   SE3 G, L;

@@ -26,7 +26,7 @@ struct ReplayRun {
   SE3 truth;  // T_gnss_lidar
   Eigen::Vector3d t_error = Eigen::Vector3d::Zero();
   double rotation_error_deg = 0;
-  std::vector<MotionPair> pairs;       // the default: 1 s every 0.1 s
+  std::vector<MotionPair> pairs;       // the default: 0.3 s and 1 s pairs every 0.1 s
   std::vector<MotionPair> end_to_end;  // 1 s pairs end to end: stations for OpenCV
 };
 
@@ -95,6 +95,7 @@ inline ReplayRun replay_vbr(const Trajectory& gt, uint64_t seed, double rtk_corr
   run.pairs = motion_pairs(part.odometry, part.gnss, po);
   PairOptions end_to_end = po;
   end_to_end.stride_s = 0;
+  end_to_end.spacings_s = {1.0};
   run.end_to_end = motion_pairs(part.odometry, part.gnss, end_to_end);
   const std::vector<MotionPair>& pairs = run.pairs;
   run.closed = closed_form(pairs);

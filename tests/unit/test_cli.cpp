@@ -470,8 +470,9 @@ TEST_F(Cli, HandEyeOpenCalibCarIsFlaggedNearPlanar) {
 
 // Motion-capture pairs (ETH's PrimeSense camera tracked against a target, and its Vicon body,
 // 100 Hz stamped to 10 ms): the clock offset estimated, an extrinsic, per-pair residuals in the
-// report. The fit explains the motions: the median rotation residual is a small fraction of the
-// median rotation of a pair.
+// report. The fit explains the motions: among the 1 s pairs, the median rotation residual is a
+// small fraction of the median rotation of a pair (the 0.3 s pairs turn 3-4 times less with the
+// same per-pose noise of the camera's tracking; the report gives each length its noise level).
 TEST_F(Cli, HandEyeEthMotionCapture) {
   RIGCAL_REQUIRE_FIXTURE(dir, "hand_eye/ethz/prime_sense_color_w_vicon_1/prime_sense_1");
   const std::string rep = (dir_ / "rep").string();
@@ -488,6 +489,9 @@ TEST_F(Cli, HandEyeEthMotionCapture) {
   const nlohmann::json j = nlohmann::json::parse(slurp(fs::path(rep) / "hand_eye.json"));
   std::vector<double> rot, res_rot, res_trans;
   for (const auto& p : j["pairs"]) {
+    const double length =
+        std::stod(p["t1_s"].get<std::string>()) - std::stod(p["t0_s"].get<std::string>());
+    if (length < 0.9) continue;
     rot.push_back(p["rotation_deg"]);
     res_rot.push_back(p["rotation_residual_deg"]);
     res_trans.push_back(p["translation_residual_m"]);
@@ -502,6 +506,11 @@ TEST_F(Cli, HandEyeEthMotionCapture) {
       j["inputs"]["gnss_time_offset_s"].get<double>());
   EXPECT_LT(res_rot[m], 0.2 * rot[m]);
   EXPECT_TRUE(j["observability"]["unobservable_directions"].empty());
+  ASSERT_EQ(j["pair_noise"]["levels"].size(), 2u);
+  for (const auto& level : j["pair_noise"]["levels"]) {
+    EXPECT_GT(level["pairs"].get<size_t>(), 100u);
+    EXPECT_GT(level["rotation_deg"].get<double>(), 0.0);
+  }
 }
 
 // GNSS fixes as CSV: the simulated GNSS/INS poses written as latitude, longitude, height and NED
