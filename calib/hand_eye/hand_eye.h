@@ -33,7 +33,7 @@ struct MotionPair {
 
 struct PairOptions {
   // t1 - t0: pairs of each of these lengths. A hand-held rig's rotation grows slower than the
-  // spacing (its sway and shake: 0.3 s pairs of the VBR walks turn 55-70 % as much as 1 s pairs)
+  // spacing (its sway and shake: 0.3 s pairs of the VBR walks turn 35-55 % as much as 1 s pairs)
   // while the odometry's noise grows as its square root, so short pairs add information that 1 s
   // pairs miss, and 1 s pairs hold the slower turns (doc/hand-eye.md, "Pair lengths").
   std::vector<double> spacings_s = {0.3, 1.0};
