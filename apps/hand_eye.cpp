@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -135,8 +136,11 @@ void run(const Options& o) {
         to_seconds_text(l0), to_seconds_text(l1), to_seconds_text(g0), to_seconds_text(g1),
         offset_s));
   }
+  std::vector<double> spacings = o.spacings_s;  // each length once, shortest first
+  std::sort(spacings.begin(), spacings.end());
+  spacings.erase(std::unique(spacings.begin(), spacings.end()), spacings.end());
   hand_eye::PairOptions po;
-  po.spacings_s = o.spacings_s;
+  po.spacings_s = spacings;
   po.stride_s = o.stride_s;
   po.min_rotation_deg = o.min_rotation_deg;
   po.time_offset_s = offset_s;
@@ -146,7 +150,7 @@ void run(const Options& o) {
     throw Error(fmt::format(
         "{} motion pairs of {} s rotating at least {} deg: too few or too small motions (at least "
         "3 are needed; rotate the rig about changing axes, or lower --min-rotation)",
-        pairs.size(), fmt::join(o.spacings_s, " and "), o.min_rotation_deg));
+        pairs.size(), fmt::join(spacings, " and "), o.min_rotation_deg));
   }
   const hand_eye::ClosedForm cf = hand_eye::closed_form(pairs, o.max_sigma_m);
   const hand_eye::Observability& ob = cf.observability;
@@ -219,7 +223,7 @@ void run(const Options& o) {
   fmt::print(
       "{} motion pairs of {} s, {} (LiDAR {} poses, GNSS/INS {} poses); {} left out of the "
       "closed form by the consensus\n",
-      pairs.size(), fmt::join(o.spacings_s, " and "),
+      pairs.size(), fmt::join(spacings, " and "),
       o.stride_s > 0 ? fmt::format("each length every {} s", o.stride_s) : "end to end",
       lidar.size(), gnss.size(), cf.rejected);
   for (const hand_eye::Refined::PairNoise& n : r.pair_noise) {
@@ -244,7 +248,7 @@ void run(const Options& o) {
   std::vector<io::OutputFile> files;
   if (!o.report.empty()) {
     io::HandEyeInputs in{
-        o.lidar,       o.gnss, o.rig, offset_s, o.spacings_s, o.stride_s, o.min_rotation_deg,
+        o.lidar,       o.gnss, o.rig, offset_s, spacings, o.stride_s, o.min_rotation_deg,
         o.max_sigma_m, notes};
     files = io::hand_eye_report_files(o.report, in, pairs, cf, r, lidar, gnss);
   }

@@ -483,9 +483,12 @@ std::vector<MotionPair> motion_pairs(const Trajectory& lidar, const Trajectory& 
   for (double s : o.spacings_s) {
     if (!(s > 0)) throw Error(fmt::format("pair spacing {} s: must be positive", s));
   }
+  std::vector<double> spacings = o.spacings_s;  // each length once
+  std::sort(spacings.begin(), spacings.end());
+  spacings.erase(std::unique(spacings.begin(), spacings.end()), spacings.end());
   const Trajectory gnss = smooth_poses(raw_gnss, o.gnss_half_window_s);
   std::vector<MotionPair> pairs;
-  for (double s : o.spacings_s) pairs_of_length(lidar, gnss, o, s, pairs);
+  for (double s : spacings) pairs_of_length(lidar, gnss, o, s, pairs);
   std::stable_sort(pairs.begin(), pairs.end(), [](const MotionPair& a, const MotionPair& b) {
     return a.t0 < b.t0 || (a.t0 == b.t0 && a.t1 < b.t1);
   });

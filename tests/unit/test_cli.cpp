@@ -678,6 +678,9 @@ TEST_F(Cli, HandEyeWritesTheExtrinsicAndRefusesAnUndeterminedDirection) {
   r = run("hand-eye" + args(car) + " --prior z=-0.13");
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("expected x=METRES,SIGMA"), std::string::npos) << r.err;
+  r = run("hand-eye" + args(car) + " --spacing 0.3,0");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("must be positive"), std::string::npos) << r.err;
   // Trajectories that do not overlap in time, and too few pairs: exit 2.
   const fs::path a = write("a.tum", "0 0 0 0 0 0 0 1\n1 1 0 0 0 0 0 1\n2 2 0 0 0 0 0 1\n");
   const fs::path b = write("b.tum", "100 0 0 0 0 0 0 1\n101 1 0 0 0 0 0 1\n102 2 0 0 0 0 0 1\n");
