@@ -13,6 +13,10 @@ struct TruthZ {
   std::vector<double> projection;  // |projection error| / mrcal-style 1-sigma, 5 pixels a camera
   // The figures: worst of both cameras, and the stereo extrinsic's errors.
   double focal_rel = 0, principal_point_px = 0, baseline_m = 0, rotation_deg = 0;
+  // The reported 1-sigmas behind the principal-point and rotation bars: cx, cy of each
+  // camera (px), and the stereo rotation about each axis (deg).
+  std::vector<double> principal_point_sigma_px;
+  Eigen::Vector3d rotation_sigma_deg = Eigen::Vector3d::Zero();
 };
 
 // Every seed's figures are printed; nothing is asserted per seed.

@@ -165,6 +165,8 @@ TruthZ check_against_truth(const SimCase& sc, uint64_t seed, bool print, bool st
     const double pp = std::max(std::abs(est.cx - truth.cx), std::abs(est.cy - truth.cy));
     out.focal_rel = std::max(out.focal_rel, f_rel);
     out.principal_point_px = std::max(out.principal_point_px, pp);
+    out.principal_point_sigma_px.push_back(r.cameras[c].stddev[2]);
+    out.principal_point_sigma_px.push_back(r.cameras[c].stddev[3]);
     if (print) {
       std::printf(
           "seed %lu camera %d: focal rel. error %.2e, principal point %.3f px (1-sigma reported "
@@ -233,6 +235,7 @@ TruthZ check_against_truth(const SimCase& sc, uint64_t seed, bool print, bool st
   out.projection = zp;
   out.baseline_m = baseline_err;
   out.rotation_deg = rot_err.norm();
+  out.rotation_sigma_deg = r.rotation_stddev_deg[1];
   return out;
 }
 
