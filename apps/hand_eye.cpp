@@ -4,7 +4,6 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -136,15 +135,13 @@ void run(const Options& o) {
         to_seconds_text(l0), to_seconds_text(l1), to_seconds_text(g0), to_seconds_text(g1),
         offset_s));
   }
-  std::vector<double> spacings = o.spacings_s;  // each length once, shortest first
-  std::sort(spacings.begin(), spacings.end());
-  spacings.erase(std::unique(spacings.begin(), spacings.end()), spacings.end());
   hand_eye::PairOptions po;
-  po.spacings_s = spacings;
+  po.spacings_s = o.spacings_s;
   po.stride_s = o.stride_s;
   po.min_rotation_deg = o.min_rotation_deg;
   po.time_offset_s = offset_s;
   po.gnss_half_window_s = o.gnss_smoothing_s;
+  const std::vector<double> spacings = hand_eye::pair_lengths(po);
   const std::vector<hand_eye::MotionPair> pairs = hand_eye::motion_pairs(lidar, gnss, po);
   if (pairs.size() < 3) {
     throw Error(fmt::format(

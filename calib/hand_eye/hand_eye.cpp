@@ -45,8 +45,23 @@ void velocity(const Trajectory& traj, Time t, Time max_gap, Eigen::Vector3d& w,
   v = d.t / 0.1;
 }
 
+// A pair's LiDAR motion with the clock moved by dt: A(dt) = exp(-dt xi0) A exp(dt xi1), to first
+// order in dt (xi: the LiDAR's body velocities at the pair's ends, MotionPair).
+template <typename T>
+void shifted(const Eigen::Quaterniond& q_A, const Eigen::Vector3d& t_A, const Eigen::Vector3d& w0,
+             const Eigen::Vector3d& v0, const Eigen::Vector3d& w1, const Eigen::Vector3d& v1,
+             const T& dt, Eigen::Quaternion<T>& qA, Eigen::Matrix<T, 3, 1>& tA) {
+  const Eigen::Matrix<T, 3, 1> a0 = -dt * w0.cast<T>(), a1 = dt * w1.cast<T>();
+  T c0[4], c1[4];  // w x y z
+  ceres::AngleAxisToQuaternion(a0.data(), c0);
+  ceres::AngleAxisToQuaternion(a1.data(), c1);
+  const Eigen::Quaternion<T> q0(c0[0], c0[1], c0[2], c0[3]), q1(c1[0], c1[1], c1[2], c1[3]);
+  qA = q0 * q_A.cast<T>() * q1;
+  tA = q0 * (t_A.cast<T>() + q_A.cast<T>() * (dt * v1.cast<T>())) - dt * v0.cast<T>();
+}
+
 // One pair: rotation 2 vec(q_B^-1 q_X q_A q_X^-1) and translation R_B t_X + t_B - R_X s t_A - t_X
-// (s: the odometry's scale correction), each over its sigma.
+// (s: the odometry's scale correction; A moved with the clock correction dt), each over its sigma.
 struct PairError {
   Eigen::Quaterniond q_A, q_B;
   Eigen::Vector3d t_A, t_B;
@@ -56,15 +71,9 @@ struct PairError {
   bool operator()(const T* q_x, const T* t_x, const T* scale, const T* dt, T* r) const {
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> tX(t_x);
     const Eigen::Map<const Eigen::Quaternion<T>> qX(q_x);
-    // A(dt) = exp(-dt xi0) A exp(dt xi1), to first order in dt.
-    const Eigen::Matrix<T, 3, 1> a0 = -dt[0] * w0.cast<T>(), a1 = dt[0] * w1.cast<T>();
-    T c0[4], c1[4];  // w x y z
-    ceres::AngleAxisToQuaternion(a0.data(), c0);
-    ceres::AngleAxisToQuaternion(a1.data(), c1);
-    const Eigen::Quaternion<T> q0(c0[0], c0[1], c0[2], c0[3]), q1(c1[0], c1[1], c1[2], c1[3]);
-    const Eigen::Quaternion<T> qA = q0 * q_A.cast<T>() * q1;
-    const Eigen::Matrix<T, 3, 1> tA =
-        q0 * (t_A.cast<T>() + q_A.cast<T>() * (dt[0] * v1.cast<T>())) - dt[0] * v0.cast<T>();
+    Eigen::Quaternion<T> qA;
+    Eigen::Matrix<T, 3, 1> tA;
+    shifted(q_A, t_A, w0, v0, w1, v1, dt[0], qA, tA);
     const Eigen::Quaternion<T> qB = q_B.cast<T>();
     const Eigen::Quaternion<T> e = qB.conjugate() * qX * qA * qX.conjugate();
     const T sign = e.w() < T(0) ? T(-1) : T(1);
@@ -80,7 +89,9 @@ PairError pair_error(const MotionPair& p, double rot_sigma, double trans_sigma) 
           rot_sigma,        trans_sigma};
 }
 
-// The LiDAR's motion of a pair with the clock moved by dt (PairError's A(dt), in double).
+// The LiDAR's motion of a pair with the clock moved by dt, in double: shifted's formula on
+// rotation matrices, so that dt = 0 gives A exactly (a quaternion round trip would put 1e-6 deg of
+// rounding into the residuals of poses that agree to rounding, and move the outlier flags there).
 SE3 shifted_motion(const MotionPair& p, double dt) {
   const Eigen::Matrix3d R0 = rotation_from_vector(-dt * p.w0), R1 = rotation_from_vector(dt * p.w1);
   return SE3{R0 * p.A.R * R1, R0 * (p.A.t + p.A.R * (dt * p.v1)) - dt * p.v0};
@@ -339,7 +350,7 @@ Refined refine(const std::vector<MotionPair>& pairs, const SE3& initial, const R
   // would let a noisy rotation inflate the translation's covariance, or the reverse. Each pair
   // length has its own levels (fewer than 10 inliers: all lengths' levels together).
   const auto [group, groups] = length_groups(pairs);
-  std::vector<double> rr2(groups + 1, 0.0), tr2(groups + 1, 0.0), len(groups + 1, 0.0);
+  std::vector<double> rr2(groups + 1, 0.0), tr2(groups + 1, 0.0);
   std::vector<size_t> n(groups + 1, 0);
   std::vector<std::vector<double>> lengths(groups);
   for (size_t k = 0; k < pairs.size(); ++k) {
@@ -478,17 +489,21 @@ void pairs_of_length(const Trajectory& lidar, const Trajectory& gnss, const Pair
 
 }  // namespace
 
-std::vector<MotionPair> motion_pairs(const Trajectory& lidar, const Trajectory& raw_gnss,
-                                     const PairOptions& o) {
+std::vector<double> pair_lengths(const PairOptions& o) {
   for (double s : o.spacings_s) {
     if (!(s > 0)) throw Error(fmt::format("pair spacing {} s: must be positive", s));
   }
-  std::vector<double> spacings = o.spacings_s;  // each length once
-  std::sort(spacings.begin(), spacings.end());
-  spacings.erase(std::unique(spacings.begin(), spacings.end()), spacings.end());
+  std::vector<double> lengths = o.spacings_s;
+  std::sort(lengths.begin(), lengths.end());
+  lengths.erase(std::unique(lengths.begin(), lengths.end()), lengths.end());
+  return lengths;
+}
+
+std::vector<MotionPair> motion_pairs(const Trajectory& lidar, const Trajectory& raw_gnss,
+                                     const PairOptions& o) {
   const Trajectory gnss = smooth_poses(raw_gnss, o.gnss_half_window_s);
   std::vector<MotionPair> pairs;
-  for (double s : spacings) pairs_of_length(lidar, gnss, o, s, pairs);
+  for (double s : pair_lengths(o)) pairs_of_length(lidar, gnss, o, s, pairs);
   std::stable_sort(pairs.begin(), pairs.end(), [](const MotionPair& a, const MotionPair& b) {
     return a.t0 < b.t0 || (a.t0 == b.t0 && a.t1 < b.t1);
   });

@@ -62,11 +62,15 @@ struct PairOptions {
 // is followed to 0.2 mm by +-0.05 s.
 Trajectory smooth_poses(const Trajectory& trajectory, double half_window_s);
 
-// Pairs along the GNSS/INS trajectory (smoothed, options.gnss_half_window_s): for each spacing, a
+// options.spacings_s each once, shortest first. Throws rigcal::Error on a spacing that is not
+// positive.
+std::vector<double> pair_lengths(const PairOptions& options);
+
+// Pairs along the GNSS/INS trajectory (smoothed, options.gnss_half_window_s): for each spacing
+// (pair_lengths), a
 // GNSS/INS pose at t0, the first one at least the spacing later at t1, the LiDAR odometry
-// interpolated (slerp + linear) at both instants (a spacing given twice counts once). Pairs
-// outside the odometry, across a gap, or rotating too little are skipped. In order of t0 (then
-// t1). Throws rigcal::Error on a spacing that is not positive.
+// interpolated (slerp + linear) at both instants. Pairs outside the odometry, across a gap, or
+// rotating too little are skipped. In order of t0 (then t1).
 std::vector<MotionPair> motion_pairs(const Trajectory& T_odom_lidar, const Trajectory& T_enu_gnss,
                                      const PairOptions& options = {});
 
