@@ -26,6 +26,9 @@ void add_time_offset(CLI::App& app);
 // `rigcal hand-eye`
 void add_hand_eye(CLI::App& app);
 void add_lidar_camera(CLI::App& app);
+// `rigcal calibrate`, `rigcal publish`
+void add_calibrate(CLI::App& app);
+void add_publish(CLI::App& app);
 // `rigcal target print`
 void add_target_print(CLI::App& target);
 

@@ -19,8 +19,10 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.footer(
       "Exit status: 0 success, 2 bad input (the message names file, line and key), 1 bug;\n"
-      "time-offset: 3 when the data give no offset; hand-eye: 3 when a direction is undetermined.");
+      "3 when the data do not determine the answer (time-offset, hand-eye, calibrate).");
 
+  rigcal::cli::add_calibrate(app);
+  rigcal::cli::add_publish(app);
   CLI::App* rig = app.add_subcommand("rig", "Check, show and convert a calibration YAML");
   rig->require_subcommand(1);
   rigcal::cli::add_rig_validate(*rig);

@@ -40,6 +40,9 @@ void add_rig_convert(CLI::App& parent) {
         rig::export_files(r, format, o->out, rig::ExportOptions{o->imu});
     io::write_files_atomic(files);
     for (const io::OutputFile& f : files) fmt::print("wrote {} ({})\n", f.path.string(), o->to);
+    if (format == rig::ExportFormat::vbr) {
+      for (const std::string& d : rig::vbr_drops(r)) fmt::print("dropped: {}\n", d);
+    }
   });
 }
 

@@ -1,11 +1,13 @@
 // rigcal rig show FILE: the rig as a readable table.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <cmath>
 #include <memory>
 
 #include "cli.h"
 #include "rigcal/rig/rig_yaml.h"
+#include "rigcal/session/provenance.h"
 
 namespace rigcal::cli {
 namespace {
@@ -73,6 +75,26 @@ void print_rig(const std::string& file, const rig::Rig& r) {
                optional_number(s.imu.gyroscope_random_walk, "{:.4g}"),
                optional_number(s.imu.accelerometer_noise_density, "{:.4g}"),
                optional_number(s.imu.accelerometer_random_walk, "{:.4g}"));
+  }
+  const std::vector<session::StepRecord> steps = session::read_steps(r);
+  if (!steps.empty()) {
+    fmt::print("\nProvenance (rigcal.steps: how each part was estimated):\n");
+    for (const session::StepRecord& s : steps) {
+      fmt::print("  {}: {} ({})\n", s.step, s.status, s.tool_version);
+      for (const session::HashedInput& in : s.inputs) {
+        fmt::print("    {:<15} {}{} sha256 {}\n", in.role, in.path.string(),
+                   in.files > 1 ? fmt::format(" ({} files)", in.files) : "",
+                   in.sha256.substr(0, 16));
+      }
+      for (const auto& [label, figures] :
+           {std::pair{"1-sigma", &s.sigmas}, std::pair{"residuals", &s.residuals}}) {
+        if (figures->empty()) continue;
+        std::vector<std::string> parts;
+        for (const report::Figure& f : *figures)
+          parts.push_back(fmt::format("{} {:.4g}", f.name, f.value));
+        fmt::print("    {:<15} {}\n", label, fmt::join(parts, ", "));
+      }
+    }
   }
   if (!r.notes.empty()) {
     fmt::print("\nNotes:\n");

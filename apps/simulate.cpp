@@ -90,8 +90,10 @@ void run(const Options& o) {
       fmt::print(" {:.1f} s\n",
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     }
-    io::write_files_atomic(
-        {{tmp / "truth.yaml", rig::rig_to_yaml(rig)}, {tmp / "truth.json", truth.dump(2) + "\n"}});
+    io::write_files_atomic({{tmp / "truth.yaml", rig::rig_to_yaml(rig)},
+                            {tmp / "truth.json", truth.dump(2) + "\n"},
+                            {tmp / "target.yaml", io::target_to_yaml(config.target)},
+                            {tmp / "session.yaml", io::simulated_session_yaml(parts)}});
     if (fs::exists(out, ec)) fs::remove_all(out);
     fs::rename(tmp, out);
   } catch (...) {

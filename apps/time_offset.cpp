@@ -2,26 +2,18 @@
 // by cross-correlating their angular velocities (doc/time-offset.md).
 #include <fmt/format.h>
 
-#include <cmath>
-#include <filesystem>
 #include <limits>
 #include <memory>
 
 #include "cli.h"
 #include "rigcal/core/error.h"
-#include "rigcal/core/se3.h"
 #include "rigcal/core/text.h"
-#include "rigcal/core/time.h"
-#include "rigcal/io/files.h"
-#include "rigcal/io/rates_io.h"
-#include "rigcal/io/time_sync_report.h"
-#include "rigcal/rig/rig_yaml.h"
-#include "rigcal/time_sync/time_sync.h"
+#include "rigcal/io/session.h"
+#include "rigcal/time_sync/step.h"
+#include "step_output.h"
 
 namespace rigcal::cli {
 namespace {
-
-namespace fs = std::filesystem;
 
 struct Options {
   std::string reference, other, session, sensor, reference_sensor, rig, out, report;
@@ -32,8 +24,8 @@ struct Options {
   bool no_three_axis = false;
 };
 
-io::RateFile read_stream(const std::string& path, const std::string& format,
-                         const std::string& columns, const char* what) {
+io::RateReadOptions read_options(const std::string& format, const std::string& columns,
+                                 const char* what) {
   io::RateReadOptions ro;
   try {
     ro.format = io::rate_format_from_string(format);
@@ -43,127 +35,63 @@ io::RateFile read_stream(const std::string& path, const std::string& format,
   ro.columns = columns;
   if (!columns.empty() && ro.format == io::RateReadOptions::Format::automatic)
     ro.format = io::RateReadOptions::Format::table;
-  return io::read_rates(path, ro);
+  return ro;
 }
 
-void run(Options o) {
-  // Inputs: explicit files, or the session's two IMU folders (the LiDAR's internal IMU, on the
-  // base clock, as reference; the external IMU as the other stream).
-  if (!o.session.empty()) {
-    if (!fs::is_directory(o.session))
-      throw Error(fmt::format("--session {}: not a folder", o.session));
-    if (o.reference.empty()) o.reference = (fs::path(o.session) / "ouster_imu").string();
-    if (o.other.empty()) o.other = (fs::path(o.session) / "imu").string();
-    if (o.sensor.empty()) o.sensor = "imu";
-    if (o.reference_sensor.empty()) o.reference_sensor = "os_imu";
-  }
-  if (o.reference.empty() || o.other.empty())
-    throw Error("give --reference and --other (IMU logs or trajectories), or --session DIR");
-  if (!o.out.empty() && (o.rig.empty() || o.sensor.empty()))
-    throw Error("--out writes the time_offset of --sensor into --rig: give both");
-
-  time_sync::TimeSyncOptions topt;
+time_sync::TimeSyncOptions sync_options(const Options& o) {
+  time_sync::TimeSyncOptions t;
   if (o.max_offset == "all") {
-    topt.max_offset_s = std::numeric_limits<double>::infinity();
+    t.max_offset_s = std::numeric_limits<double>::infinity();
   } else {
     try {
-      topt.max_offset_s = parse_double(o.max_offset, "--max-offset");
+      t.max_offset_s = parse_double(o.max_offset, "--max-offset");
     } catch (const Error&) {
-      topt.max_offset_s = 0;
+      t.max_offset_s = 0;
     }
-    if (!(topt.max_offset_s > 0))
+    if (!(t.max_offset_s > 0))
       throw Error(
           fmt::format("--max-offset: expected seconds > 0 or 'all', got '{}'", o.max_offset));
   }
   if (!(o.min_overlap > 0 && o.min_overlap <= 1))
     throw Error(fmt::format("--min-overlap: expected a fraction in (0, 1], got {}", o.min_overlap));
   if (o.window_s < 0) throw Error("--window: expected seconds >= 0 (0: automatic)");
-  topt.min_overlap = o.min_overlap;
-  topt.window_s = o.window_s;
-  topt.min_excitation_rad_s = o.min_excitation;
-  topt.three_axis = !o.no_three_axis;
+  t.min_overlap = o.min_overlap;
+  t.window_s = o.window_s;
+  t.min_excitation_rad_s = o.min_excitation;
+  t.three_axis = !o.no_three_axis;
+  return t;
+}
 
-  // The rig, read before the work so that a bad rig fails fast.
-  rig::Rig rig;
-  io::TimeSyncInputs in;
-  in.reference = o.reference, in.other = o.other;
-  in.sensor = o.sensor, in.reference_sensor = o.reference_sensor;
-  if (!o.rig.empty()) {
-    rig = rig::read_rig_file(o.rig);
-    if (!o.sensor.empty() && !rig::find_sensor(rig, o.sensor))
-      throw Error(fmt::format("--sensor {}: no such sensor in {}", o.sensor, o.rig));
-    if (!o.reference_sensor.empty()) {
-      const rig::Sensor* ref = rig::find_sensor(rig, o.reference_sensor);
-      if (!ref)
-        throw Error(
-            fmt::format("--reference-sensor {}: no such sensor in {}", o.reference_sensor, o.rig));
-      in.reference_time_offset_s = ref->time_offset;
-    }
-  }
-  if (o.reference_sensor.empty())
-    in.notes.push_back("no --reference-sensor: the reference stream is taken as on the base clock");
+void run(const Options& o) {
+  // Inputs: explicit files, or the session's motion recording (the LiDAR's internal IMU, on the
+  // base clock, as reference; the external IMU as the other stream), each unless given.
+  time_sync::StepInputs in;
+  if (!o.session.empty())
+    in = time_sync::streams_of_recording(io::recording_for(io::read_session(o.session), "motion"));
+  if (!o.reference.empty()) in.reference.path = o.reference;
+  if (!o.other.empty()) in.other.path = o.other;
+  if (!o.sensor.empty()) in.other.sensor = o.sensor;
+  if (!o.reference_sensor.empty()) in.reference.sensor = o.reference_sensor;
+  if (in.reference.path.empty() || in.other.path.empty())
+    throw Error("give --reference and --other (IMU logs or trajectories), or --session DIR");
+  if (!o.out.empty() && (o.rig.empty() || in.other.sensor.empty()))
+    throw Error("--out writes the time_offset of --sensor into --rig: give both");
+  const time_sync::TimeSyncOptions topt = sync_options(o);
+  in.reference.read = read_options(o.reference_format, o.reference_columns, "reference");
+  in.other.read = read_options(o.other_format, o.other_columns, "other");
+  if (!o.rig.empty()) in.rig = rig::read_rig_file(o.rig);  // read first: a bad rig fails fast
 
-  const io::RateFile ref =
-      read_stream(o.reference, o.reference_format, o.reference_columns, "reference");
-  const io::RateFile oth = read_stream(o.other, o.other_format, o.other_columns, "other");
-  in.reference_format = ref.format, in.other_format = oth.format;
-  for (const std::string& n : ref.notes) in.notes.push_back("reference: " + n);
-  for (const std::string& n : oth.notes) in.notes.push_back("other: " + n);
-  fmt::print("reference {}: {} samples ({}), {:.1f} s\n", o.reference, ref.rates.stamps.size(),
-             ref.format, (ref.rates.stamps.back() - ref.rates.stamps.front()).seconds());
-  fmt::print("other     {}: {} samples ({}), {:.1f} s\n", o.other, oth.rates.stamps.size(),
-             oth.format, (oth.rates.stamps.back() - oth.rates.stamps.front()).seconds());
-
-  const time_sync::TimeSyncResult r = time_sync::estimate_time_offset(ref.rates, oth.rates, topt);
-
-  std::vector<io::OutputFile> files;
-  if (!o.report.empty()) {
-    files = io::time_sync_report_files(o.report, r, topt, in, ref.rates, oth.rates);
-  }
-  if (r.verdict != "ok") {
-    io::write_files_atomic(files);
-    fmt::print(stderr, "rigcal: no offset: {}: {}{}\n", r.verdict, r.reason,
-               o.out.empty() ? "" : fmt::format(" ({} not written)", o.out));
-    throw Exit{3};
-  }
-
-  fmt::print("offset: t_reference = t_other + {:.6f} s (1-sigma {:.6f} s = {:.3f} ms)\n",
-             r.offset_s, r.sigma_s, 1e3 * r.sigma_s);
-  fmt::print("peak: NCC {:.3f}, second peak {:.3f} at {:+.4f} s (ratio {:.2f}); overlap {:.1f} s\n",
-             r.peak_ncc, r.second_peak_ncc, r.second_peak_offset_s, r.peak_ratio, r.overlap_s);
-  if (r.three_axis) {
-    const Eigen::Vector3d rpy = roll_pitch_yaw(r.R_reference_other) * 180.0 / M_PI;
-    fmt::print(
-        "rotation other -> reference (roll pitch yaw): {:.3f} {:.3f} {:.3f} deg; residual RMS "
-        "{:.4f} rad/s\n",
-        rpy.x(), rpy.y(), rpy.z(), r.residual_rms_rad_s);
-  }
-  if (r.drift_estimated) {
-    fmt::print("drift: {:.3f} ± {:.3f} ppm over {} windows of {:.0f} s: {}\n", r.drift_ppm,
-               r.drift_sigma_ppm, r.windows.size(), r.window_s,
-               r.drift_significant ? "significant (offset given at the epoch, the other stream's "
-                                     "first stamp)"
-                                   : "not significant");
-  } else {
-    fmt::print("drift: not estimated (fewer than 4 usable windows)\n");
-  }
-
+  const report::StepResult r = time_sync::estimate_clock(in, topt, console_progress());
+  finish_step(r, o.out, o.report);
   if (!o.out.empty()) {
-    rig::set_clock_from(rig, o.sensor, o.reference_sensor, r.offset_s,
-                        r.drift_significant ? r.drift_ppm : 0.0, r.epoch);
-    files.push_back({o.out, rig::rig_to_yaml(rig)});
-  }
-  io::write_files_atomic(files);
-  if (!o.out.empty()) {
-    const rig::Sensor& s = rig::sensor(rig, o.sensor);
-    fmt::print("{}: time_offset {:.6f} s{} written to {}\n", o.sensor, s.time_offset,
+    const rig::Sensor& s = rig::sensor(r.rig, in.other.sensor);
+    fmt::print("{}: time_offset {:.6f} s{} written to {}\n", s.name, s.time_offset,
                s.time_drift_ppm ? fmt::format(", time_drift_ppm {:.3f} from {}", *s.time_drift_ppm,
                                               to_seconds_text(s.time_drift_epoch))
                                 : "",
                o.out);
   }
-  for (const std::string& n : in.notes) fmt::print("note: {}\n", n);
-  if (!o.report.empty()) fmt::print("report: {}/report.json and PNGs\n", o.report);
+  if (!o.report.empty()) fmt::print("report: {}/time_sync.json and PNGs\n", o.report);
 }
 
 }  // namespace
@@ -185,8 +113,8 @@ void add_time_offset(CLI::App& app) {
   cmd->add_option("--reference", o->reference, "the reference stream (file or vbr IMU folder)");
   cmd->add_option("--other", o->other, "the stream whose offset is measured");
   cmd->add_option("--session", o->session,
-                  "a session folder: reference DIR/ouster_imu (sensor os_imu), other DIR/imu "
-                  "(sensor imu), unless given");
+                  "a session (its motion/ recording) or a recording: reference ouster_imu/ "
+                  "(sensor os_imu), other imu/ (sensor imu), unless given");
   cmd->add_option("--reference-format", o->reference_format, "auto | vbr | table | trajectory")
       ->capture_default_str();
   cmd->add_option("--other-format", o->other_format, "auto | vbr | table | trajectory")
@@ -201,8 +129,7 @@ void add_time_offset(CLI::App& app) {
   cmd->add_option("--rig", o->rig, "the rig to update");
   cmd->add_option("--out", o->out, "output calibration YAML (needs --rig and --sensor)");
   cmd->add_option("--report", o->report,
-                  "report folder: report.json, correlation.png, "
-                  "aligned.png, windows.png");
+                  "report folder: time_sync.json, correlation.png, aligned.png, windows.png");
   cmd->add_option("--max-offset", o->max_offset,
                   "search |offset| up to this many seconds, or 'all' (every lag with enough "
                   "overlap)")

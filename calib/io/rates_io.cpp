@@ -98,16 +98,21 @@ RateFile read_vbr(const fs::path& dir) {
   const std::vector<TextLine> lines = data_lines(text, &headers);
   const std::vector<TextLine> stamp_lines = data_lines(stamp_text, nullptr);
   const std::vector<std::string_view> names = split_fields(headers);
+  // The angular rate's columns: vbr-devkit's own header names them gyr_x, gyr_y, gyr_z (its
+  // later names repeat, so only these are looked up); the ROS message's field names
+  // angular_velocity.x, .y, .z are read too. The first match of each counts.
   int w[3] = {-1, -1, -1};
   for (size_t i = 0; i < names.size(); ++i) {
     for (int a = 0; a < 3; ++a) {
-      if (names[i] == std::string("angular_velocity.") + "xyz"[a]) w[a] = static_cast<int>(i);
+      if (w[a] < 0 && (names[i] == std::string("angular_velocity.") + "xyz"[a] ||
+                       names[i] == std::string("gyr_") + "xyz"[a]))
+        w[a] = static_cast<int>(i);
     }
   }
   if (w[0] < 0 || w[1] < 0 || w[2] < 0) {
     fail_at(data.string(), 1, "",
-            "the vbr-devkit header must name angular_velocity.x, angular_velocity.y and "
-            "angular_velocity.z");
+            "the IMU header must name gyr_x, gyr_y and gyr_z (vbr-devkit) or angular_velocity.x, "
+            "angular_velocity.y and angular_velocity.z");
   }
   if (lines.size() != stamp_lines.size()) {
     throw Error(fmt::format("{} has {} samples but {} has {} stamps", data.string(), lines.size(),
@@ -198,8 +203,10 @@ RateFile read_rates(const fs::path& path, const RateReadOptions& opt) {
     format = Format::vbr;
   } else {
     text = read_text_file(path);
+    const size_t eol = text.find('\n');
     const bool vbr_header = text.rfind("linear_acceleration.x", 0) == 0 ||
-                            text.find("angular_velocity.x") < text.find('\n');
+                            text.rfind("acc_x,", 0) == 0 || text.find("angular_velocity.x") < eol ||
+                            text.find("gyr_x") < eol;
     if (format == Format::vbr || (format == Format::automatic && vbr_header)) {
       format = Format::vbr;
       vbr_dir = path.parent_path().parent_path();  // <dir>/data/imu.txt

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cstring>
 #include <opencv2/imgcodecs.hpp>
 
@@ -57,6 +58,25 @@ void write_points(const fs::path& dir, const std::vector<Time>& stamps,
 }
 
 }  // namespace
+
+std::string simulated_session_yaml(const std::vector<std::string>& parts) {
+  auto has = [&](std::string_view p) {
+    return std::find(parts.begin(), parts.end(), p) != parts.end();
+  };
+  std::string out =
+      "# Written by rigcal simulate: which recording serves which step (doc/session.md).\n"
+      "target: target.yaml\n";
+  if (has("stereo")) out += "cameras: stereo\n";
+  if (has("lidar-camera")) out += "lidar_camera: lidar_camera\n";
+  if (has("imu")) out += "motion: .\n";
+  if (has("trajectories")) {
+    out +=
+        "# The LiDAR odometry stands in for rigcal's own until it has one.\n"
+        "odometry: trajectories/lidar_odometry.tum\n"
+        "gnss: trajectories/gnss_ins.tum\n";
+  }
+  return out;
+}
 
 std::string timestamps_txt(const std::vector<Time>& stamps) {
   std::string out;

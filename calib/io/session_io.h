@@ -24,6 +24,11 @@ void write_trajectories(const std::filesystem::path& dir, const sim::TrajectoryP
 void write_scans(const std::filesystem::path& dir, const sim::ScanPart& part,
                  nlohmann::json& truth);
 
+// session.yaml of a simulated session (doc/session.md) with the parts written ("stereo",
+// "lidar-camera", "imu", "trajectories", "scans"): the recordings of each step, target.yaml, and
+// the motion's odometry and GNSS/INS trajectories; the truth is not named as a prior rig.
+std::string simulated_session_yaml(const std::vector<std::string>& parts);
+
 // The vbr-devkit IMU layout: timestamps.txt (ISO-8601 a line) and data/imu.txt (a header line,
 // then 37 comma-separated columns: acc xyz, gyro xyz, orientation wxyz, three 3x3 covariances).
 std::string imu_txt(const std::vector<sim::ImuSample>& samples);

@@ -6,6 +6,7 @@
 #include <set>
 
 #include "rigcal/core/error.h"
+#include "rigcal/core/text.h"
 #include "rigcal/io/files.h"
 #include "rigcal/io/yaml.h"
 
@@ -78,6 +79,25 @@ camera::Target parse_target_yaml(std::string_view text, std::string_view file) {
 
 camera::Target read_target_file(const std::filesystem::path& path) {
   return parse_target_yaml(read_text_file(path), path.string());
+}
+
+std::string target_to_yaml(const camera::Target& t) {
+  camera::validate(t);
+  std::string out;
+  if (t.type == camera::TargetType::checkerboard) {
+    out += fmt::format(
+        "target_type: checkerboard\ntargetCols: {}\ntargetRows: {}\nrowSpacingMeters: {}\n"
+        "colSpacingMeters: {}\n",
+        t.cols, t.rows, format_double(t.square), format_double(t.square));
+  } else {
+    out += fmt::format(
+        "target_type: aprilgrid\ntagCols: {}\ntagRows: {}\ntagSize: {}\ntagSpacing: {}\n", t.cols,
+        t.rows, format_double(t.tag_size), format_double(t.tag_spacing));
+  }
+  out += fmt::format("name: {}\n", t.name);
+  if (t.margin >= 0) out += fmt::format("margin: {}\n", format_double(t.margin));
+  out += fmt::format("thickness: {}\n", format_double(t.thickness));
+  return out;
 }
 
 }  // namespace rigcal::io

@@ -112,7 +112,7 @@ std::vector<OutputFile> time_sync_report_files(
     const std::filesystem::path& dir, const TimeSyncResult& r, const time_sync::TimeSyncOptions& o,
     const TimeSyncInputs& in, const AngularRates& reference, const AngularRates& other) {
   std::vector<OutputFile> files;
-  files.push_back({dir / "report.json", time_sync_json(r, o, in).dump(2) + "\n"});
+  files.push_back({dir / "time_sync.json", time_sync_json(r, o, in).dump(2) + "\n"});
   {
     Plot p;
     p.title = "Normalized correlation of |w| against the offset";

@@ -1,5 +1,5 @@
 #pragma once
-// The time-offset report (doc/time-offset.md): report.json and quick-look PNGs of the
+// The time-offset report (doc/time-offset.md): time_sync.json and quick-look PNGs of the
 // correlation around the peak, the aligned signals and the windowed offsets.
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -23,7 +23,7 @@ nlohmann::json time_sync_json(const time_sync::TimeSyncResult& result,
                               const time_sync::TimeSyncOptions& options,
                               const TimeSyncInputs& inputs);
 
-// report.json, correlation.png, aligned.png and (when windows were estimated) windows.png.
+// time_sync.json, correlation.png, aligned.png and (when windows were estimated) windows.png.
 std::vector<OutputFile> time_sync_report_files(const std::filesystem::path& dir,
                                                const time_sync::TimeSyncResult& result,
                                                const time_sync::TimeSyncOptions& options,

@@ -1,6 +1,7 @@
 #include "rigcal/rig/export.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
@@ -314,6 +315,29 @@ std::vector<io::OutputFile> export_files(const Rig& rig, ExportFormat format,
     }
   }
   throw Error("unknown export format");
+}
+
+std::vector<std::string> vbr_drops(const Rig& rig) {
+  std::vector<std::string> out;
+  std::vector<std::string> offsets, drifts, attached;
+  for (const Sensor& s : rig.sensors) {
+    if (s.time_offset != 0.0) offsets.push_back(fmt::format("{} {} s", s.name, s.time_offset));
+    if (s.time_drift_ppm) drifts.push_back(fmt::format("{} {} ppm", s.name, *s.time_drift_ppm));
+    if (!s.attached_to.empty()) attached.push_back(fmt::format("{} to {}", s.name, s.attached_to));
+  }
+  if (!offsets.empty()) {
+    out.push_back(fmt::format(
+        "clock offsets (the VBR format has none; its users take every stamp as on the base "
+        "clock): {}",
+        fmt::join(offsets, ", ")));
+  }
+  if (!drifts.empty()) out.push_back(fmt::format("clock drifts: {}", fmt::join(drifts, ", ")));
+  if (!attached.empty())
+    out.push_back(fmt::format("rigid attachments: {}", fmt::join(attached, ", ")));
+  for (const auto& [key, text] : rig.extra_metadata) {
+    if (key == "steps") out.push_back("the steps' provenance (rigcal.steps)");
+  }
+  return out;
 }
 
 }  // namespace rigcal::rig

@@ -46,6 +46,10 @@ std::string ros_camera_info_yaml(const Rig& rig, std::string_view camera);
 // equidistant cameras: mrcal 2.2 has no Kannala-Brandt model.
 std::string mrcal_cameramodel(const Rig& rig, std::string_view camera);
 
+// What a VBR-only file (rig_to_vbr_yaml) leaves out of this rig, a line each: clock offsets and
+// drifts, rigid attachments, rigcal's section (provenance, notes). Empty when nothing is lost.
+std::vector<std::string> vbr_drops(const Rig& rig);
+
 // The files `rigcal rig convert --to FORMAT --out OUT` writes: OUT itself for single-file formats,
 // OUT/<camera>.yaml (ros) or OUT/<camera>.cameramodel (mrcal) for the per-camera ones.
 std::vector<io::OutputFile> export_files(const Rig& rig, ExportFormat format,

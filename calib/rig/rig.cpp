@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <set>
 
 #include "rigcal/core/error.h"
@@ -142,6 +143,24 @@ std::vector<Problem> find_problems(const Rig& rig) {
         if (*value && !(**value > 0)) add(key, fmt::format("must be > 0, got {}", **value));
       }
     }
+    if (!s.attached_to.empty()) {
+      if (s.attached_to == s.name) {
+        add("attached_to", "a sensor cannot be attached to itself");
+      } else if (!find_sensor(rig, s.attached_to)) {
+        add("attached_to", fmt::format("'{}' is not a sensor of the rig", s.attached_to));
+      } else {
+        // Following attached_to from here must end: no cycle.
+        std::string at = s.attached_to;
+        for (size_t hops = 0; !at.empty(); ++hops) {
+          if (hops > rig.sensors.size()) {
+            add("attached_to", "the attachments form a cycle");
+            break;
+          }
+          const Sensor* next = find_sensor(rig, at);
+          at = next ? next->attached_to : "";
+        }
+      }
+    }
     if (s.type == SensorType::gnss && s.gnss_frame != "ins" && s.gnss_frame != "antenna") {
       add("frame", fmt::format("expected ins or antenna, got '{}'", s.gnss_frame));
     }
@@ -151,6 +170,23 @@ std::vector<Problem> find_problems(const Rig& rig) {
                    fmt::format("base frame '{}' is not a sensor of the rig", rig.base_frame)});
   }
   return out;
+}
+
+std::vector<std::string> move_rigidly(Rig& rig, std::string_view name, const SE3& T_base_new) {
+  const SE3 T_new_old = T_base_new * sensor(rig, name).T_base_sensor.inverse();
+  std::vector<std::string> moved{std::string(name)};
+  for (size_t i = 0; i < moved.size(); ++i) {
+    for (const Sensor& s : rig.sensors) {
+      if (s.attached_to == moved[i] && std::find(moved.begin(), moved.end(), s.name) == moved.end())
+        moved.push_back(s.name);
+    }
+  }
+  sensor(rig, name).T_base_sensor = T_base_new;  // exactly, not through T_new_old
+  for (size_t i = 1; i < moved.size(); ++i) {
+    Sensor& s = sensor(rig, moved[i]);
+    s.T_base_sensor = T_new_old * s.T_base_sensor;
+  }
+  return moved;
 }
 
 void set_clock_from(Rig& rig, std::string_view sensor_name, std::string_view reference,

@@ -63,6 +63,9 @@ struct Sensor {
   CameraModel camera;              // type == camera only
   ImuSpec imu;                     // type == imu only
   std::string gnss_frame = "ins";  // type == gnss only: "ins" or "antenna"
+  // The sensor this one is rigidly mounted with ("" for none): an estimate that moves that one
+  // moves this one too (the INS's own IMU is attached to the GNSS/INS).
+  std::string attached_to;
 
   // Keys rigcal does not know, kept as YAML flow text and written back unchanged.
   std::vector<std::pair<std::string, std::string>> extra_keys;
@@ -89,6 +92,11 @@ std::vector<const Sensor*> cameras(const Rig& rig);
 // T_a_b between two sensors: maps points of sensor b's frame into sensor a's frame,
 // T_a_b = inv(a.T_b) * b.T_b. Example: T_a_b(rig, "cam_l", "lidar") is T_cam_l_lidar.
 SE3 T_a_b(const Rig& rig, std::string_view a, std::string_view b);
+
+// Places `sensor` at T_base_sensor and moves every sensor attached to it (attached_to, followed
+// transitively) with it, keeping their poses relative to it. Returns the names moved, `sensor`
+// first.
+std::vector<std::string> move_rigidly(Rig& rig, std::string_view sensor, const SE3& T_base_sensor);
 
 // Sets `sensor`'s clock from a measurement against another clock,
 //     t_reference = t_sensor + offset_s + drift_ppm * 1e-6 * (t_sensor - epoch),

@@ -33,6 +33,7 @@ const std::set<std::string> kKnownKeys = {"sensor_type",
                                           "update_rate",
                                           "model",
                                           "frame",
+                                          "attached_to",
                                           "gyroscope_noise_density",
                                           "gyroscope_random_walk",
                                           "accelerometer_noise_density",
@@ -113,7 +114,20 @@ class Reader {
   std::map<std::string, int> lines_;
 };
 
-std::string flow_text(const YAML::Node& n) {
+// Every map and list of `n` in flow style (the style it was read in is kept by yaml-cpp).
+void flow_style(YAML::Node n) {
+  if (!(n.IsMap() || n.IsSequence())) return;
+  n.SetStyle(YAML::EmitterStyle::Flow);
+  if (n.IsMap()) {
+    for (auto it = n.begin(); it != n.end(); ++it) flow_style(it->second);
+  } else {
+    for (YAML::Node c : n) flow_style(c);
+  }
+}
+
+std::string flow_text(const YAML::Node& node) {
+  YAML::Node n = YAML::Clone(node);
+  flow_style(n);
   YAML::Emitter e;
   e << YAML::Flow << n;
   return e.c_str();
@@ -177,6 +191,7 @@ Sensor read_sensor(Reader& r, const std::string& name, const YAML::Node& node, b
   }
   if (const YAML::Node n = node["update_rate"]) s.update_rate = r.number(n, key_of("update_rate"));
   if (const YAML::Node n = node["model"]) s.model = r.text(n, key_of("model"));
+  if (const YAML::Node n = node["attached_to"]) s.attached_to = r.text(n, key_of("attached_to"));
 
   auto forbid = [&](std::initializer_list<const char*> keys, std::string_view belongs_to) {
     for (const char* k : keys) {
@@ -302,6 +317,44 @@ std::string yaml_string(const std::string& s) {
   return out + "\"";
 }
 
+// Maps and lists in block style for people (entries of a list stay on one line each), scalars
+// and empty collections as they are.
+void block_style(YAML::Node n, bool in_list) {
+  if (n.IsMap() || n.IsSequence()) {
+    if (n.size() == 0) return;
+    n.SetStyle(in_list && n.IsMap() ? YAML::EmitterStyle::Flow : YAML::EmitterStyle::Block);
+    if (n.IsMap()) {
+      for (auto it = n.begin(); it != n.end(); ++it) block_style(it->second, false);
+    } else {
+      for (YAML::Node c : n) block_style(c, true);
+    }
+  }
+}
+
+// One key of the rigcal section, kept as flow text, written at indent 2.
+std::string metadata_yaml(const std::string& key, const std::string& text) {
+  YAML::Node n;
+  try {
+    n = YAML::Load(text);
+  } catch (const YAML::Exception&) {
+    return fmt::format("  {}: {}\n", yaml_string(key), text);
+  }
+  if (!(n.IsMap() || n.IsSequence()) || n.size() == 0)
+    return fmt::format("  {}: {}\n", yaml_string(key), text);
+  block_style(n, false);
+  YAML::Emitter e;
+  e.SetIndent(2);
+  e << n;
+  std::string out = fmt::format("  {}:\n", yaml_string(key));
+  std::string_view body = e.c_str();
+  while (!body.empty()) {
+    const size_t eol = body.find('\n');
+    out += fmt::format("    {}\n", body.substr(0, eol));
+    body = eol == std::string_view::npos ? std::string_view() : body.substr(eol + 1);
+  }
+  return out;
+}
+
 constexpr const char* kHeader =
     "# Calibration of a sensor rig, written by rigcal (format: doc/calibration-yaml.md).\n"
     "# T_b: the sensor's pose in the base frame (p_base = T_b * p_sensor), 4x4, rows; metres.\n"
@@ -346,6 +399,8 @@ std::string sensors_yaml(const Rig& rig, bool full) {
       if (!s.model.empty()) out += fmt::format("  model: {}\n", yaml_string(s.model));
       if (s.type == SensorType::gnss)
         out += fmt::format("  frame: {}\n", yaml_string(s.gnss_frame));
+      if (!s.attached_to.empty())
+        out += fmt::format("  attached_to: {}\n", yaml_string(s.attached_to));
       for (const auto& [key, text] : s.extra_keys)
         out += fmt::format("  {}: {}\n", yaml_string(key), text);
     }
@@ -435,8 +490,7 @@ std::string rig_to_yaml(const Rig& rig) {
     out += "  notes:\n";
     for (const std::string& n : rig.notes) out += fmt::format("    - {}\n", yaml_string(n));
   }
-  for (const auto& [key, text] : rig.extra_metadata)
-    out += fmt::format("  {}: {}\n", yaml_string(key), text);
+  for (const auto& [key, text] : rig.extra_metadata) out += metadata_yaml(key, text);
   return out;
 }
 

@@ -380,7 +380,7 @@ TEST_F(Cli, TimeOffsetWritesTheSensorsOffsetAndDrift) {
                  out + " --report " + report);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(run("rig validate " + out).status, 0);
-  const nlohmann::json j = nlohmann::json::parse(slurp(fs::path(report) / "report.json"));
+  const nlohmann::json j = nlohmann::json::parse(slurp(fs::path(report) / "time_sync.json"));
   EXPECT_EQ(j["verdict"], "ok");
   EXPECT_NEAR(j["sensor_time_offset_s"].get<double>(), -0.0031, 0.05e-3);
   EXPECT_TRUE(j["drift"]["significant"].get<bool>());
@@ -412,7 +412,7 @@ TEST_F(Cli, TimeOffsetWritesTheSensorsOffsetAndDrift) {
   EXPECT_EQ(r.status, 3);
   EXPECT_NE(r.err.find("not enough excitation"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out2));
-  EXPECT_EQ(nlohmann::json::parse(slurp(fs::path(rep2) / "report.json"))["verdict"],
+  EXPECT_EQ(nlohmann::json::parse(slurp(fs::path(rep2) / "time_sync.json"))["verdict"],
             "not enough excitation");
 
   // Bad input: exit 2, one line, nothing written.

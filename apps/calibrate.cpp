@@ -1,0 +1,110 @@
+// rigcal calibrate SESSION --out DIR: the whole session, step by step, published once
+// (doc/session.md).
+#include "rigcal/session/calibrate.h"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <memory>
+
+#include "cli.h"
+#include "step_output.h"
+
+namespace rigcal::cli {
+namespace {
+
+struct Options {
+  session::CalibrateOptions run;
+  std::string rig, target, odometry, gnss, out, bayer;
+  bool no_estimate_offset = false;
+};
+
+// The summary table: one row a step, then each step's reason where it did not end ok.
+void print_table(const session::CalibrateResult& r) {
+  fmt::print("\n  {:<13} {:<13} {:>8}  {}\n", "step", "status", "time", "result");
+  for (const session::StepRun& s : r.steps) {
+    std::string result;
+    for (const report::Figure& f : s.residuals) {
+      if (result.size() > 60) break;
+      result += fmt::format("{}{} {:.4g}{}", result.empty() ? "" : ", ", f.name, f.value,
+                            f.unit.empty() || f.name.ends_with(f.unit) ? "" : " " + f.unit);
+    }
+    fmt::print("  {:<13} {:<13} {:>8}  {}\n", s.step, s.status,
+               s.cached        ? "cached"
+               : s.seconds > 0 ? fmt::format("{:.2f} s", s.seconds)
+                               : "-",
+               s.status == "ok" ? result : s.reason);
+  }
+}
+
+void run(Options o) {
+  o.run.rig = o.rig, o.run.target = o.target, o.run.odometry = o.odometry, o.run.gnss = o.gnss;
+  o.run.out = o.out;
+  o.run.cameras.bayer = io::bayer_from_string(o.bayer);
+  o.run.hand_eye.estimate_offset = !o.no_estimate_offset;
+  const session::CalibrateResult r = session::calibrate(o.run, console_progress());
+  for (const session::StepRun& s : r.steps) {
+    if (s.status == "not run") continue;
+    fmt::print("== {}: {}{}\n", s.step, s.status, s.cached ? " (cached: inputs unchanged)" : "");
+    for (const std::string& line : s.summary) fmt::print("{}\n", line);
+    for (const std::string& n : s.notes) fmt::print("note: {}\n", n);
+    if (s.status != "ok") fmt::print("{}: {}\n", s.status, s.reason);
+    if (!s.remedy.empty()) fmt::print("what would settle it: {}\n", s.remedy);
+  }
+  print_table(r);
+  if (r.published) {
+    fmt::print("\npublished {} (rigcal rig show prints its provenance); reports in {}/reports/\n",
+               r.calibration.string(), o.out);
+    return;
+  }
+  std::vector<std::string> open;
+  for (const session::StepRun& s : r.steps) {
+    if (s.status != "ok") open.push_back(fmt::format("{} ({})", s.step, s.status));
+  }
+  fmt::print(stderr, "rigcal: nothing published: {}\n", fmt::join(open, ", "));
+  if (r.exit_status != 0) throw Exit{r.exit_status};
+}
+
+}  // namespace
+
+void add_calibrate(CLI::App& app) {
+  auto o = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand(
+      "calibrate",
+      "Calibrate a whole session in one run (doc/session.md): cameras (stereo/), LiDAR-camera\n"
+      "(lidar_camera/, the right camera), the IMU clock offsets (motion/), hand-eye GNSS/INS to\n"
+      "LiDAR with the clock offset (motion/ with --odometry). Writes OUT/calib.yaml once,\n"
+      "atomically, with rigcal.steps (inputs and their sha256, tool version, sigmas, residuals),\n"
+      "and OUT/reports/<step>/. A rerun reuses each step whose inputs, rig entries and options\n"
+      "are unchanged (OUT/cache/). Exit 0 published; 2 a step failed on bad input; 3 a step is\n"
+      "undetermined by the data: the other steps' results are kept, nothing is published.");
+  cmd->add_option("session", o->run.session, "the session folder, or a single recording")
+      ->required();
+  cmd->add_option("--out", o->out, "output folder")->required();
+  cmd->add_option("--rig", o->rig, "prior rig (default: session.yaml's rig, or SESSION/rig.yaml)");
+  cmd->add_option("--target", o->target,
+                  "target YAML (default: session.yaml's target, or SESSION/target.yaml)");
+  cmd->add_option("--odometry", o->odometry,
+                  "the motion recording's LiDAR odometry, T_odom_lidar (TUM, KITTI, EuRoC)");
+  cmd->add_option("--gnss", o->gnss,
+                  "the GNSS/INS trajectory or fixes (default: motion/gnss/poses.tum or fixes.csv)");
+  cmd->add_option("--attitude", o->run.hand_eye.attitude, "GNSS fixes only: enu | ned")
+      ->check(CLI::IsMember({"enu", "ned"}));
+  cmd->add_option("--from", o->run.from,
+                  "rerun this step and the ones after it (the earlier ones from the cache)");
+  cmd->add_option("--only", o->run.only,
+                  "rerun only this step; the others from the cache where it holds them");
+  cmd->add_option("--model", o->run.cameras.model,
+                  "camera model: pinhole-radtan | pinhole-radtan5 | pinhole-equidistant")
+      ->capture_default_str();
+  cmd->add_option("--bayer", o->bayer, "raw Bayer images: rggb | bggr | grbg | gbrg");
+  cmd->add_option("--lidar-camera", o->run.lidar_camera.camera,
+                  "the camera of the LiDAR-camera step")
+      ->capture_default_str();
+  cmd->add_flag("--no-estimate-offset", o->no_estimate_offset,
+                "hand-eye: keep the rig's GNSS/INS clock offset (a disagreement the "
+                "trajectories show is reported)");
+  cmd->callback([o] { run(*o); });
+}
+
+}  // namespace rigcal::cli

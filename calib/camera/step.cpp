@@ -1,0 +1,268 @@
+#include "rigcal/camera/step.h"
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+
+#include <atomic>
+#include <map>
+#include <mutex>
+
+#include "rigcal/camera/calibrate.h"
+#include "rigcal/camera/uncertainty.h"
+#include "rigcal/core/error.h"
+#include "rigcal/core/stats.h"
+#include "rigcal/io/camera_report.h"
+#include "rigcal/io/files.h"
+#include "rigcal/io/target_yaml.h"
+#include "rigcal/rig/rig_yaml.h"
+
+namespace rigcal::camera {
+namespace {
+
+CalibrationOptions calibration_options(const StepOptions& o) {
+  CalibrationOptions c;
+  if (o.model == "pinhole-radtan")
+    c.model = rig::DistortionModel::radtan, c.radtan_coefficients = 4;
+  else if (o.model == "pinhole-radtan5")
+    c.model = rig::DistortionModel::radtan, c.radtan_coefficients = 5;
+  else if (o.model == "pinhole-equidistant")
+    c.model = rig::DistortionModel::equidistant;
+  else
+    throw Error(fmt::format(
+        "--model: expected pinhole-radtan, pinhole-radtan5 or pinhole-equidistant, got '{}'",
+        o.model));
+  c.outlier_k_sigma = o.outlier_sigma;
+  return c;
+}
+
+struct Detections {
+  std::vector<CameraInput> cameras;
+  std::vector<std::pair<size_t, size_t>> jobs;  // (camera, frame) with an image
+  size_t found = 0, from_cache = 0;
+};
+
+// The target in every image: from the cache where it holds the image, else detected (in
+// parallel); each camera's image size checked to be one.
+Detections detect_all(const Target& target, const io::ImageSet& in, const StepOptions& o,
+                      const std::filesystem::path& cache_path, const report::Progress& progress) {
+  const size_t n_cams = in.names.size(), n_frames = in.files[0].size();
+  std::map<std::string, Detection> cache;
+  if (!cache_path.empty() && std::filesystem::exists(cache_path))
+    cache = io::parse_corners_vnl(io::read_text_file(cache_path), target);
+  Detections d;
+  for (size_t c = 0; c < n_cams; ++c) {
+    for (size_t f = 0; f < n_frames; ++f) {
+      if (!in.files[c][f].empty()) d.jobs.emplace_back(c, f);
+    }
+  }
+  d.cameras.resize(n_cams);
+  for (size_t c = 0; c < n_cams; ++c) {
+    d.cameras[c].name = in.names[c];
+    d.cameras[c].frames.assign(n_frames, Detection{});
+  }
+  std::vector<std::vector<cv::Size>> sizes(n_cams, std::vector<cv::Size>(n_frames));
+  std::atomic<size_t> done{0}, from_cache{0};
+  std::mutex tell;
+  tbb::parallel_for(size_t(0), d.jobs.size(), [&](size_t j) {
+    const auto [c, f] = d.jobs[j];
+    const std::string& file = in.files[c][f];
+    const cv::Mat img = io::read_gray(file, o.bayer);
+    sizes[c][f] = img.size();
+    if (auto it = cache.find(file); it != cache.end()) {
+      d.cameras[c].frames[f] = it->second;
+      ++from_cache;
+    } else {
+      d.cameras[c].frames[f] = detect(img, target);
+    }
+    const size_t k = ++done;
+    std::lock_guard<std::mutex> lock(tell);
+    report::tell(progress, "detecting the target", k, d.jobs.size());
+  });
+  for (size_t c = 0; c < n_cams; ++c) {
+    cv::Size first;
+    std::string first_file;
+    for (size_t f = 0; f < n_frames; ++f) {
+      if (in.files[c][f].empty()) continue;
+      if (first.empty()) first = sizes[c][f], first_file = in.files[c][f];
+      if (sizes[c][f] != first) {
+        throw Error(
+            fmt::format("camera {}: {} is {}x{} but {} is {}x{}: one camera, one image size",
+                        in.names[c], in.files[c][f], sizes[c][f].width, sizes[c][f].height,
+                        first_file, first.width, first.height));
+      }
+    }
+    d.cameras[c].width = first.width;
+    d.cameras[c].height = first.height;
+  }
+  for (const auto& [c, f] : d.jobs) d.found += d.cameras[c].frames[f].found;
+  d.from_cache = from_cache;
+  return d;
+}
+
+// The rig: intrinsics of every camera; cameras after the first placed through the stereo
+// extrinsic, the first keeping its T_b.
+rig::Rig updated_rig(const StepInputs& in, const CalibrationResult& r) {
+  const std::vector<std::string>& names = in.images.names;
+  rig::Rig rig;
+  if (in.rig) {
+    rig = *in.rig;
+  } else {
+    rig.base_frame = names[0];
+    rig.notes.push_back(fmt::format("no --rig: {} is the base frame", names[0]));
+  }
+  for (size_t c = 0; c < names.size(); ++c) {
+    rig::Sensor* s = rig::find_sensor(rig, names[c]);
+    if (!s) {
+      rig.sensors.push_back({});
+      s = &rig.sensors.back();
+      s->name = names[c];
+      s->type = rig::SensorType::camera;
+    }
+    if (s->type != rig::SensorType::camera)
+      throw Error(fmt::format("sensor '{}' of the rig is not a camera", s->name));
+    s->camera = r.cameras[c].model;
+  }
+  const SE3 T_b_cam0 = rig::sensor(rig, names[0]).T_base_sensor;
+  for (size_t c = 1; c < names.size(); ++c)
+    rig::sensor(rig, names[c]).T_base_sensor = T_b_cam0 * r.T_cam_cam0[c].inverse();
+  return rig;
+}
+
+std::vector<std::string> summary_lines(const std::vector<std::string>& names,
+                                       const CalibrationResult& r,
+                                       const io::CameraReportInput& rep) {
+  std::vector<std::string> out;
+  out.push_back(fmt::format(
+      "RMS reprojection error: {:.4f} px per corner (2-D, OpenCV's), {:.4f} px per coordinate "
+      "(mrcal's); {} outlier corners of {}",
+      r.rms_2d_px, r.rms_coord_px, r.n_outliers, r.residuals.size()));
+  for (size_t c = 0; c < names.size(); ++c) {
+    const auto& m = r.cameras[c].model;
+    const auto& s = r.cameras[c].stddev;
+    out.push_back(fmt::format(
+        "{}: fx {:.3f} ± {:.3f}, fy {:.3f} ± {:.3f}, cx {:.3f} ± {:.3f}, cy {:.3f} ± {:.3f} px ({} "
+        "views); projection 1-sigma at {:.2f} m: mean {:.3f}, max {:.3f} px",
+        names[c], m.fx, s[0], m.fy, s[1], m.cx, s[2], m.cy, s[3], r.cameras[c].n_views,
+        rep.uncertainty_distance_m, rep.uncertainty[c].mean_px, rep.uncertainty[c].max_px));
+  }
+  for (size_t c = 1; c < names.size(); ++c) {
+    out.push_back(fmt::format(
+        "T_{}_{}: baseline {:.5f} m, t = [{:.5f} {:.5f} {:.5f}] ± [{:.5f} {:.5f} {:.5f}] m, "
+        "rotation ± [{:.4f} {:.4f} {:.4f}] deg",
+        names[c], names[0], r.T_cam_cam0[c].t.norm(), r.T_cam_cam0[c].t.x(), r.T_cam_cam0[c].t.y(),
+        r.T_cam_cam0[c].t.z(), r.translation_stddev_m[c].x(), r.translation_stddev_m[c].y(),
+        r.translation_stddev_m[c].z(), r.rotation_stddev_deg[c].x(), r.rotation_stddev_deg[c].y(),
+        r.rotation_stddev_deg[c].z()));
+  }
+  return out;
+}
+
+}  // namespace
+
+report::StepResult calibrate_cameras(const StepInputs& in, const StepOptions& o,
+                                     const report::Progress& progress) {
+  const Target target = io::read_target_file(in.target);
+  const CalibrationOptions copt = calibration_options(o);
+  const std::vector<std::string>& names = in.images.names;
+  if (names.empty() || in.images.files.empty() || in.images.files[0].empty())
+    throw Error("the camera step was given no images");
+  const size_t n_cams = names.size(), n_frames = in.images.files[0].size();
+
+  const Detections d = detect_all(target, in.images, o, in.corners_cache, progress);
+  report::StepResult out;
+  out.step = "cameras";
+  out.summary.push_back(fmt::format(
+      "target '{}' found in {} of {} images{}", target.name, d.found, d.jobs.size(),
+      d.from_cache ? fmt::format(" ({} from {})", d.from_cache, in.corners_cache.string()) : ""));
+  if (d.found == 0)
+    throw Error(
+        fmt::format("the target '{}' was found in none of the {} images; check the target file "
+                    "(inner corners, not squares)",
+                    target.name, d.jobs.size()));
+
+  const CalibrationResult r = calibrate(target, d.cameras, copt);
+  out.rig = updated_rig(in, r);
+  out.wrote = names;
+
+  // Report.
+  io::CameraReportInput rep;
+  rep.camera_names = names;
+  rep.images = in.images.files;
+  rep.inputs = {{"target", in.target.string()}, {"model", o.model}};
+  std::vector<double> distances;
+  for (const auto& T : r.T_cam0_board) {
+    if (T) distances.push_back(T->t.norm());
+  }
+  rep.uncertainty_distance_m = median(distances);
+  const int nk = static_cast<int>(r.cameras[0].stddev.size());
+  for (size_t c = 0; c < n_cams; ++c) {
+    rep.uncertainty.push_back(
+        projection_uncertainty(r, static_cast<int>(c), rep.uncertainty_distance_m));
+    rep.uncertainty_intrinsics_only.push_back(projection_uncertainty_intrinsics_only(
+        r.cameras[c].model, r.covariance.block(c * nk, c * nk, nk, nk),
+        rep.uncertainty_distance_m));
+  }
+  out.report = io::cameras_json(r, rep);
+  for (const std::string& n : in.images.notes) out.report["notes"].push_back(n);
+  std::vector<std::string> all_images;
+  std::vector<Detection> all_detections;
+  for (const auto& [c, f] : d.jobs)
+    all_images.push_back(in.images.files[c][f]), all_detections.push_back(d.cameras[c].frames[f]);
+  out.report_files.push_back({"corners.vnl", io::corners_vnl(target, all_images, all_detections)});
+  out.report_files.push_back({"cameras.json", out.report.dump(2) + "\n"});
+  report::finish_report(out, "cameras.json");
+  for (size_t c = 0; c < n_cams; ++c) {
+    const int w = d.cameras[c].width, h = d.cameras[c].height;
+    for (size_t f = 0; f < n_frames; ++f) {
+      if (d.cameras[c].frames[f].found) {
+        out.report_files.push_back(
+            {fmt::format("{}_corners.png", names[c]),
+             io::encode_png(io::corners_png(io::read_gray(in.images.files[c][f], o.bayer),
+                                            d.cameras[c].frames[f]))});
+        break;
+      }
+    }
+    out.report_files.push_back(
+        {fmt::format("{}_residuals.png", names[c]),
+         io::encode_png(io::residuals_png(r, static_cast<int>(c), w, h, 100.0))});
+    out.report_files.push_back({fmt::format("{}_coverage.png", names[c]),
+                                io::encode_png(io::coverage_png(r, static_cast<int>(c), w, h))});
+    out.report_files.push_back({fmt::format("{}_uncertainty.png", names[c]),
+                                io::encode_png(io::uncertainty_png(rep.uncertainty[c], w, h))});
+  }
+
+  for (const std::string& line : summary_lines(names, r, rep)) out.summary.push_back(line);
+  out.notes = r.notes;
+  for (const std::string& n : in.images.notes) out.notes.push_back(n);
+  out.residuals = {{"rms_2d_px", r.rms_2d_px, "px"},
+                   {"rms_coord_px", r.rms_coord_px, "px"},
+                   {"outlier_corners", static_cast<double>(r.n_outliers), ""},
+                   {"corners", static_cast<double>(r.residuals.size()), ""}};
+  static const char* kIntrinsics[] = {"fx", "fy", "cx", "cy"};
+  for (size_t c = 0; c < n_cams; ++c) {
+    for (int i = 0; i < 4; ++i) {
+      out.sigmas.push_back(
+          {fmt::format("{}.{}", names[c], kIntrinsics[i]), r.cameras[c].stddev[i], "px"});
+    }
+  }
+  for (size_t c = 1; c < n_cams; ++c) {
+    const std::string T = fmt::format("T_{}_{}", names[c], names[0]);
+    for (int a = 0; a < 3; ++a) {
+      out.sigmas.push_back(
+          {fmt::format("{}.t.{}", T, "xyz"[a]), r.translation_stddev_m[c][a], "m"});
+    }
+    for (int a = 0; a < 3; ++a) {
+      out.sigmas.push_back(
+          {fmt::format("{}.rotation.{}", T, "xyz"[a]), r.rotation_stddev_deg[c][a], "deg"});
+    }
+  }
+  out.inputs.push_back({"target", in.target});
+  for (size_t c = 0; c < n_cams; ++c) {
+    for (const std::string& f : in.images.files[c]) {
+      if (!f.empty()) out.inputs.push_back({"images " + names[c], f});
+    }
+  }
+  return out;
+}
+
+}  // namespace rigcal::camera

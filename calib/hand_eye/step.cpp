@@ -1,0 +1,256 @@
+#include "rigcal/hand_eye/step.h"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <cmath>
+
+#include "rigcal/core/error.h"
+#include "rigcal/core/se3.h"
+#include "rigcal/core/text.h"
+#include "rigcal/io/gnss_fixes.h"
+#include "rigcal/io/hand_eye_report.h"
+
+namespace rigcal::hand_eye {
+namespace {
+
+// The GNSS/INS trajectory: poses as they are, or fixes (latitude, longitude, height, attitude)
+// turned into a local ENU frame at the first fix.
+Trajectory read_gnss(const StepInputs& in, const StepOptions& o,
+                     const io::TrajectoryReadOptions& read, std::vector<std::string>& notes) {
+  if (!io::is_gnss_fixes_file(in.gnss)) return io::read_trajectory(in.gnss, read).trajectory;
+  if (o.attitude.empty()) {
+    throw Error(fmt::format(
+        "{} holds GNSS fixes: give --attitude enu (yaw counter-clockwise from east) or ned "
+        "(heading clockwise from north, body x forward, z down); see doc/hand-eye.md",
+        in.gnss.string()));
+  }
+  const io::GnssFixes fixes = io::read_gnss_fixes(in.gnss, io::attitude_from_string(o.attitude));
+  std::string stds;
+  if (fixes.median_horizontal_std_m)
+    stds += fmt::format("; median std horizontal {:.3f} m", *fixes.median_horizontal_std_m);
+  if (fixes.median_vertical_std_m)
+    stds += fmt::format(", vertical {:.3f} m", *fixes.median_vertical_std_m);
+  notes.push_back(fmt::format(
+      "GNSS fixes converted to ENU (GeographicLib, WGS84) at the first fix: latitude {:.9f}, "
+      "longitude {:.9f}, height {:.3f} m; attitude convention {}{}",
+      fixes.origin.latitude_deg, fixes.origin.longitude_deg, fixes.origin.height_m, o.attitude,
+      stds));
+  return fixes.T_enu_gnss;
+}
+
+report::StepResult undetermined(report::StepResult out, std::string reason, std::string remedy) {
+  out.status = report::StepStatus::undetermined;
+  out.reason = std::move(reason);
+  out.remedy = std::move(remedy);
+  return out;
+}
+
+}  // namespace
+
+report::StepResult estimate_extrinsic(const StepInputs& in, const StepOptions& o,
+                                      const report::Progress& progress) {
+  report::StepResult out;
+  out.step = "hand_eye";
+  out.inputs = {{"lidar odometry", in.lidar}, {"gnss", in.gnss}};
+  double offset_s = 0.0;
+  SE3 T_base_lidar;
+  std::optional<SE3> prior_T_gnss_lidar;
+  if (in.rig) {
+    out.rig = *in.rig;
+    const rig::Sensor* g = rig::find_sensor(*in.rig, o.sensor);
+    const rig::Sensor* l = rig::find_sensor(*in.rig, o.lidar_sensor);
+    if (!g) throw Error(fmt::format("--sensor {}: no such sensor in {}", o.sensor, in.rig_source));
+    if (!l)
+      throw Error(
+          fmt::format("--lidar-sensor {}: no such sensor in {}", o.lidar_sensor, in.rig_source));
+    offset_s = g->time_offset - l->time_offset;
+    T_base_lidar = l->T_base_sensor;
+    prior_T_gnss_lidar = g->T_base_sensor.inverse() * T_base_lidar;
+  }
+  io::TrajectoryReadOptions read;
+  read.duplicates = o.duplicates;
+  report::tell(progress, "reading the trajectories", 0, 2);
+  const Trajectory lidar = io::read_trajectory(in.lidar, read).trajectory;
+  report::tell(progress, "reading the trajectories", 1, 2);
+  std::vector<std::string>& notes = out.notes;
+  const Trajectory gnss = read_gnss(in, o, read, notes);
+  report::tell(progress, "reading the trajectories", 2, 2);
+  if (lidar.size() < 2 || gnss.size() < 2) throw Error("each trajectory needs at least 2 poses");
+
+  // The clock offset from the two trajectories' angular velocities (doc/time-offset.md), around
+  // the rig's value: t_lidar = t_gnss + offset.
+  // Without estimate_offset it is still estimated, to say when the rig's value disagrees.
+  time_sync::TimeSyncResult sync;
+  if (o.estimate_offset) {
+    sync = estimate_clock_offset(lidar, gnss, offset_s);
+  } else {
+    try {
+      sync = estimate_clock_offset(lidar, gnss, offset_s);
+    } catch (const Error& e) {
+      sync.verdict = "error";
+      sync.reason = e.what();
+    }
+  }
+  if (o.estimate_offset) {
+    if (sync.verdict != "ok") {
+      return undetermined(
+          out,
+          fmt::format("the clock offset cannot be estimated: {}: {}", sync.verdict, sync.reason),
+          "turn the rig about changing axes while both trajectories are recorded, or give the "
+          "GNSS/INS time_offset in the rig and do not estimate it");
+    }
+    offset_s = sync.offset_s;
+    out.summary.push_back(
+        fmt::format("clock offset: t_lidar = t_gnss + {:.6f} s (1-sigma {:.3f} ms, NCC {:.3f})",
+                    offset_s, 1e3 * sync.sigma_s, sync.peak_ncc));
+  } else if (sync.verdict == "ok" &&
+             std::abs(sync.offset_s - offset_s) > std::max(3 * sync.sigma_s, 1e-3)) {
+    notes.push_back(fmt::format(
+        "the trajectories' angular velocities put the clocks {:+.3f} ms (1-sigma {:.3f} ms) from "
+        "the rig's offset (t_lidar = t_gnss + {:.6f} s), which is used as it is: estimate the "
+        "offset (--estimate-offset) unless the rig's value is known to be right",
+        1e3 * (sync.offset_s - offset_s), 1e3 * sync.sigma_s, offset_s));
+  }
+  const Time l0 = lidar.stamps.front(), l1 = lidar.stamps.back();
+  const Time g0 = gnss.stamps.front() + Time::from_seconds(offset_s),
+             g1 = gnss.stamps.back() + Time::from_seconds(offset_s);
+  if (g1 <= l0 || l1 <= g0) {
+    throw Error(fmt::format(
+        "the trajectories do not overlap in time: LiDAR [{}, {}] s, GNSS/INS [{}, {}] s on the "
+        "LiDAR clock (GNSS/INS time_offset {} s): check the clocks and --rig",
+        to_seconds_text(l0), to_seconds_text(l1), to_seconds_text(g0), to_seconds_text(g1),
+        offset_s));
+  }
+  PairOptions po = o.pairs;
+  po.time_offset_s = offset_s;
+  const std::vector<double> spacings = pair_lengths(po);
+  report::tell(progress, "motion pairs", 0, 1);
+  const std::vector<MotionPair> pairs = motion_pairs(lidar, gnss, po);
+  if (pairs.size() < 3) {
+    throw Error(fmt::format(
+        "{} motion pairs of {} s rotating at least {} deg: too few or too small motions (at least "
+        "3 are needed; rotate the rig about changing axes, or lower --min-rotation)",
+        pairs.size(), fmt::join(spacings, " and "), po.min_rotation_deg));
+  }
+  const ClosedForm cf = closed_form(pairs, o.max_sigma_m);
+  const Observability& ob = cf.observability;
+
+  // Directions the data do not determine: a fix along them, or the prior rig's value, or no
+  // answer for them.
+  RefineOptions ro = o.refine;
+  ro.estimate_time_offset = o.estimate_offset;
+  if (o.estimate_offset) {
+    notes.push_back(fmt::format(
+        "clock offset estimated from the trajectories' angular velocities: t_lidar = t_gnss + "
+        "{:.6f} s, 1-sigma {:.6f} s, peak NCC {:.3f}",
+        offset_s, sync.sigma_s, sync.peak_ncc));
+  }
+  if (ob.near_planar) {
+    const Eigen::Vector3d& n = ob.dominant_axis;
+    notes.push_back(fmt::format(
+        "near-planar motion: the rotation axes stay within a narrow cone about [{:.3f} {:.3f} "
+        "{:.3f}] (GNSS/INS frame; rotation singular values {:.3f} {:.3f} {:.3f} rad, the third "
+        "below {} of the first): the rotation about it is poorly conditioned and the translation "
+        "along it weakly determined (1-sigma below)",
+        n.x(), n.y(), n.z(), ob.rotation_singular_values[0], ob.rotation_singular_values[1],
+        ob.rotation_singular_values[2], kNearPlanarRatio));
+  }
+  const Held held = hold_unobservable(ob, prior_T_gnss_lidar, ro.fixed);
+  // Why a direction is not estimated: the motion is near-planar and it is the plane's normal, or
+  // its 1-sigma is too large.
+  auto why = [&](int i) {
+    return ob.near_planar && std::abs(ob.translation_directions.col(i).dot(ob.dominant_axis)) > 0.9
+               ? std::string("near-planar motion, the plane's normal")
+               : fmt::format("1-sigma {:.3f} m above --max-sigma {} m", ob.translation_sigma_m[i],
+                             o.max_sigma_m);
+  };
+  if (!held.uncovered.empty()) {
+    std::vector<std::string> reasons;
+    for (int i : held.uncovered) {
+      const Eigen::Vector3d d = ob.translation_directions.col(i);
+      reasons.push_back(
+          fmt::format("the motion does not determine the translation along [{:.3f} {:.3f} {:.3f}] "
+                      "(GNSS/INS frame; {})",
+                      d.x(), d.y(), d.z(), why(i)));
+    }
+    return undetermined(out, fmt::format("{}", fmt::join(reasons, "; ")),
+                        "give --fix (e.g. z=0.35), --prior (z=0.35,0.02) or a --rig whose "
+                        "extrinsic holds it, or record motion that turns about that direction");
+  }
+  for (int i : held.from_prior) {
+    const Eigen::Vector3d d = ob.translation_directions.col(i);
+    notes.push_back(fmt::format(
+        "translation along [{:.3f} {:.3f} {:.3f}] (GNSS/INS frame) is not determined by the "
+        "motion ({}): kept from the rig, {:.4f} m; give --fix or --prior to set it",
+        d.x(), d.y(), d.z(), why(i), d.dot(prior_T_gnss_lidar->t)));
+  }
+  report::tell(progress, "refining", 0, 1);
+  const Refined r = refine(pairs, cf.T_gnss_lidar, ro);
+  report::tell(progress, "refining", 1, 1);
+  const SE3& X = r.T_gnss_lidar;
+  if (o.estimate_offset) {
+    // The angular-velocity estimate, refined with the extrinsic (the pairs' LiDAR motion moved
+    // with the clock to first order).
+    offset_s += r.time_offset_correction_s;
+    notes.push_back(fmt::format(
+        "clock offset refined with the extrinsic: t_lidar = t_gnss + {:.6f} s, 1-sigma {:.6f} s "
+        "({:+.3f} ms from the angular velocities' estimate)",
+        offset_s, r.time_offset_sigma_s, 1e3 * r.time_offset_correction_s));
+  }
+  const Eigen::Vector3d rpy = roll_pitch_yaw(X.R) * 180.0 / M_PI;
+  const Eigen::Vector3d &sig_r = r.rotation_sigma_deg, &sig_t = r.translation_sigma_m;
+  size_t outliers = 0;
+  for (bool b : r.outlier) outliers += b;
+
+  out.summary.push_back(fmt::format(
+      "{} motion pairs of {} s, {} (LiDAR {} poses, GNSS/INS {} poses); {} left out of the "
+      "closed form by the consensus",
+      pairs.size(), fmt::join(spacings, " and "),
+      po.stride_s > 0 ? fmt::format("each length every {} s", po.stride_s) : "end to end",
+      lidar.size(), gnss.size(), cf.rejected));
+  for (const Refined::PairNoise& n : r.pair_noise) {
+    out.summary.push_back(
+        fmt::format("pairs of {:.2f} s: {} inliers, noise {:.4f} deg and {:.4f} m per component",
+                    n.length_s, n.pairs, n.rotation_deg, n.translation_m));
+  }
+  out.summary.push_back(fmt::format(
+      "observability: rotation singular values {:.3f} {:.3f} {:.3f} rad; translation 1-sigma along "
+      "its principal directions {:.4f} {:.4f} {:.4f} m",
+      ob.rotation_singular_values[0], ob.rotation_singular_values[1],
+      ob.rotation_singular_values[2], ob.translation_sigma_m[0], ob.translation_sigma_m[1],
+      ob.translation_sigma_m[2]));
+  out.summary.push_back(
+      fmt::format("T_{}_{}: t = [{:.4f} {:.4f} {:.4f}] ± [{:.4f} {:.4f} {:.4f}] m, roll pitch yaw "
+                  "{:.3f} {:.3f} {:.3f} ± {:.3f} {:.3f} {:.3f} deg; {} outlier pairs",
+                  o.sensor, o.lidar_sensor, X.t.x(), X.t.y(), X.t.z(), sig_t.x(), sig_t.y(),
+                  sig_t.z(), rpy.x(), rpy.y(), rpy.z(), sig_r.x(), sig_r.y(), sig_r.z(), outliers));
+  out.summary.push_back(
+      fmt::format("odometry scale {:.5f} ± {:.5f} (GNSS/INS distance over LiDAR distance)",
+                  r.odometry_scale, r.odometry_scale_sigma));
+
+  io::HandEyeInputs rin{in.lidar.string(), in.gnss.string(),    in.rig_source, offset_s, spacings,
+                        po.stride_s,       po.min_rotation_deg, o.max_sigma_m, notes};
+  out.report_files = io::hand_eye_report_files("", rin, pairs, cf, r, lidar, gnss);
+  report::finish_report(out, "hand_eye.json");
+
+  if (in.rig) {
+    // The GNSS/INS placed from the LiDAR; what is rigidly attached to it moves with it.
+    out.wrote = rig::move_rigidly(out.rig, o.sensor, T_base_lidar * X.inverse());
+    if (o.estimate_offset) rig::set_clock_from(out.rig, o.sensor, o.lidar_sensor, offset_s);
+  }
+  const std::string name = fmt::format("T_{}_{}", o.sensor, o.lidar_sensor);
+  for (int a = 0; a < 3; ++a)
+    out.sigmas.push_back({fmt::format("{}.t.{}", name, "xyz"[a]), sig_t[a], "m"});
+  for (int a = 0; a < 3; ++a)
+    out.sigmas.push_back({fmt::format("{}.rotation.{}", name, "xyz"[a]), sig_r[a], "deg"});
+  if (o.estimate_offset)
+    out.sigmas.push_back({o.sensor + ".time_offset", r.time_offset_sigma_s, "s"});
+  out.residuals = {{"pairs", static_cast<double>(pairs.size()), ""},
+                   {"outlier_pairs", static_cast<double>(outliers), ""},
+                   {"noise_scale", r.noise_scale, ""},
+                   {"odometry_scale", r.odometry_scale, ""}};
+  return out;
+}
+
+}  // namespace rigcal::hand_eye

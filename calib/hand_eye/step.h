@@ -1,0 +1,42 @@
+#pragma once
+// The hand-eye step (doc/hand-eye.md): the GNSS/INS-to-LiDAR extrinsic from the LiDAR odometry
+// and the GNSS/INS trajectory, written into the rig as the GNSS/INS sensor's T_b; sensors
+// declared rigidly attached to it (`attached_to`, the INS's own IMU) move with it.
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rigcal/hand_eye/hand_eye.h"
+#include "rigcal/io/trajectory_io.h"
+#include "rigcal/report/step.h"
+
+namespace rigcal::hand_eye {
+
+struct StepOptions {
+  std::string sensor = "gnss", lidar_sensor = "lidar";  // the rig's sensors
+  io::TrajectoryReadOptions::Duplicates duplicates = io::TrajectoryReadOptions::Duplicates::error;
+  std::string attitude;  // GNSS fixes only: "enu" or "ned"
+  PairOptions pairs;     // time_offset_s is taken from the rig (and the estimate)
+  RefineOptions refine;  // estimate_time_offset follows estimate_offset
+  double max_sigma_m = 0.05;
+  // Estimate the clock offset from the trajectories' angular velocities and write it. When not,
+  // the estimate is still made and a disagreement with the rig's value is reported.
+  bool estimate_offset = false;
+};
+
+struct StepInputs {
+  std::filesystem::path lidar;  // T_odom_lidar
+  std::filesystem::path gnss;   // T_enu_gnss, or a CSV of fixes
+  std::optional<rig::Rig> rig;  // clock offsets and the prior extrinsic; none: estimate only
+  std::string rig_source;       // where the rig came from, for the report
+};
+
+// Status undetermined when the clock offset cannot be estimated (with estimate_offset) or a
+// translation direction is determined neither by the motion nor by a fix, a prior or the rig.
+// Throws rigcal::Error on bad input: unreadable trajectories, no overlap in time, too few motion
+// pairs, sensors missing from the rig.
+report::StepResult estimate_extrinsic(const StepInputs& inputs, const StepOptions& options,
+                                      const report::Progress& progress = {});
+
+}  // namespace rigcal::hand_eye

@@ -1,0 +1,22 @@
+#pragma once
+// The one image reader of the calibration steps: any image OpenCV reads (PNG, JPEG, TIFF; 8 or 16
+// bit; gray, BGR or BGRA) as 8-bit gray, raw Bayer mosaics (as VBR's cameras record them)
+// demosaiced to gray.
+#include <filesystem>
+#include <opencv2/core.hpp>
+#include <string_view>
+
+namespace rigcal::io {
+
+// A raw mosaic's 2x2 pattern, named by its first row then second row (rggb: R G / G B).
+enum class Bayer { none, rggb, bggr, grbg, gbrg };
+// "" -> none; rggb | bggr | grbg | gbrg; anything else throws rigcal::Error listing the names.
+Bayer bayer_from_string(std::string_view name);
+std::string_view to_string(Bayer bayer);
+
+// 8-bit gray. 16-bit images are scaled by 1/256; colour images converted with OpenCV's BGR
+// weights; a Bayer image (one channel) demosaiced (edge-aware) to gray. Throws rigcal::Error
+// naming the file when it cannot be read, or when a Bayer pattern is given for a colour image.
+cv::Mat read_gray(const std::filesystem::path& path, Bayer bayer = Bayer::none);
+
+}  // namespace rigcal::io

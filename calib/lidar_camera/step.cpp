@@ -1,0 +1,171 @@
+#include "rigcal/lidar_camera/step.h"
+
+#include <fmt/format.h>
+
+#include "rigcal/camera/detect.h"
+#include "rigcal/core/error.h"
+#include "rigcal/io/image_io.h"
+#include "rigcal/io/image_sets.h"
+#include "rigcal/io/lidar_camera_report.h"
+#include "rigcal/io/point_cloud_io.h"
+#include "rigcal/io/target_yaml.h"
+
+namespace rigcal::lidar_camera {
+namespace fs = std::filesystem;
+
+StepInputs pairs_from_recording(const fs::path& dir, const rig::Rig& rig, const StepOptions& o) {
+  StepInputs in;
+  in.rig = rig;
+  const io::StampedFolder images =
+      io::read_stamped_folder(dir / (o.camera == "cam_l" ? "camera_left" : "camera_right"), ".png");
+  const io::StampedFolder scans = io::read_stamped_folder(dir / "ouster_points", ".bin");
+  if (images.files.empty()) throw Error(fmt::format("{}: no images", dir.string()));
+  if (scans.files.empty()) throw Error(fmt::format("{}: no scans", dir.string()));
+  auto on_base_clock = [&](std::vector<Time> t, const std::string& sensor) {
+    const Time offset = Time::from_seconds(rig::sensor(rig, sensor).time_offset);
+    for (Time& x : t) x = x + offset;
+    return t;
+  };
+  const std::vector<std::optional<size_t>> scan_of =
+      io::pair_by_stamp(on_base_clock(images.stamps, o.camera),
+                        on_base_clock(scans.stamps, o.lidar), Time::from_seconds(o.max_dt_s));
+  for (size_t k = 0; k < scan_of.size(); ++k) {
+    if (!scan_of[k]) {
+      in.notes.push_back(
+          fmt::format("{}: no scan within {} s, skipped", images.files[k], o.max_dt_s));
+      continue;
+    }
+    in.images.push_back(images.files[k]), in.scans.push_back(scans.files[*scan_of[k]]);
+  }
+  if (in.images.empty()) {
+    throw Error(
+        fmt::format("{}: no image has a scan within {} s (--max-dt)", dir.string(), o.max_dt_s));
+  }
+  return in;
+}
+
+StepInputs pairs_from_globs(const std::string& images, const std::string& scans,
+                            const rig::Rig& rig) {
+  StepInputs in;
+  in.rig = rig;
+  const std::vector<std::string> image_glob = io::glob_files(images),
+                                 scan_glob = io::glob_files(scans);
+  if (image_glob.empty()) throw Error(fmt::format("no images match {}", images));
+  if (scan_glob.empty()) throw Error(fmt::format("no scans match {}", scans));
+  // Paired by the frame number in the names; an image or a scan without its partner is an error.
+  const io::ImageSet set = io::pair_by_frame_number({{"images", image_glob}, {"scans", scan_glob}});
+  for (size_t k = 0; k < set.files[0].size(); ++k) {
+    const std::string &img = set.files[0][k], &scan = set.files[1][k];
+    if (img.empty() || scan.empty()) {
+      throw Error(fmt::format("{} has no {} with the same frame number", img.empty() ? scan : img,
+                              img.empty() ? "image" : "scan"));
+    }
+    in.images.push_back(img), in.scans.push_back(scan);
+  }
+  return in;
+}
+
+report::StepResult calibrate_lidar_camera(const StepInputs& in, const StepOptions& o,
+                                          const report::Progress& progress) {
+  rig::Rig rig = in.rig;
+  const rig::Sensor* cam_sensor = rig::find_sensor(rig, o.camera);
+  if (!cam_sensor || cam_sensor->type != rig::SensorType::camera)
+    throw Error(fmt::format("--camera {}: no such camera in {}", o.camera, in.rig_source));
+  if (!rig::find_sensor(rig, o.lidar))
+    throw Error(fmt::format("--lidar {}: no such sensor in {}", o.lidar, in.rig_source));
+  const rig::CameraModel cam = cam_sensor->camera;
+  const camera::Target target = io::read_target_file(in.target);
+  const camera::Outline outline = camera::outline(target);
+  BoardSearch search;
+  search.board_width_m = o.board_width_m.value_or(outline.width());
+  search.board_height_m = o.board_height_m.value_or(outline.height());
+  if (o.roi) search.roi = *o.roi;
+
+  std::vector<PairInput> pairs(in.images.size());
+  std::vector<cv::Mat> shown(in.images.size());
+  for (size_t k = 0; k < in.images.size(); ++k) {
+    report::tell(progress, "pair", k + 1, in.images.size());
+    const cv::Mat gray = io::read_gray(in.images[k]);
+    if (gray.cols != cam.width || gray.rows != cam.height) {
+      throw Error(fmt::format("{}: {} x {} px, the rig's {} is {} x {}", in.images[k], gray.cols,
+                              gray.rows, o.camera, cam.width, cam.height));
+    }
+    shown[k] = gray;
+    const camera::Detection det = camera::detect(gray, target);
+    if (det.found && det.pixels.size() == camera::object_points(target).size())
+      pairs[k].camera = board_in_camera(cam, target, det.pixels, o.corner_sigma_px);
+    pairs[k].scan = io::read_point_cloud(in.scans[k]);
+  }
+  std::optional<SE3> prior;
+  if (o.camera != o.lidar) {
+    const SE3 T = rig::T_a_b(rig, o.camera, o.lidar);
+    if (!T.t.isZero()) prior = T;  // a rig with the camera placed already
+  }
+  const Calibration c = calibrate(pairs, search, prior);
+  const Solution& s = c.solution;
+
+  report::StepResult out;
+  out.step = "lidar_camera";
+  for (size_t k = 0; k < c.pairs.size(); ++k)
+    out.summary.push_back(fmt::format("pair {:2d}: {}", k + 1, c.pairs[k].note));
+  const SE3& T = s.T_camera_lidar;
+  const Eigen::Vector3d rpy = roll_pitch_yaw(T.R) * 180.0 / M_PI;
+  out.summary.push_back(fmt::format(
+      "T_{}_{}: t = [{:.4f} {:.4f} {:.4f}] ± [{:.4f} {:.4f} {:.4f}] m, roll pitch yaw {:.3f} "
+      "{:.3f} {:.3f} ± {:.3f} {:.3f} {:.3f} deg",
+      o.camera, o.lidar, T.t.x(), T.t.y(), T.t.z(), s.translation_sigma_m.x(),
+      s.translation_sigma_m.y(), s.translation_sigma_m.z(), rpy.x(), rpy.y(), rpy.z(),
+      s.rotation_sigma_deg.x(), s.rotation_sigma_deg.y(), s.rotation_sigma_deg.z()));
+  out.summary.push_back(fmt::format(
+      "observability: normals' singular values {:.3f} {:.3f} {:.3f}, condition {:.1f}; noise "
+      "scale {:.2f}",
+      s.observability.singular_values[0], s.observability.singular_values[1],
+      s.observability.singular_values[2], s.observability.condition, s.noise_scale));
+  out.notes = in.notes;
+
+  io::LidarCameraInputs rin{in.images,
+                            in.scans,
+                            in.target.string(),
+                            in.rig_source,
+                            o.camera,
+                            search.board_width_m,
+                            search.board_height_m};
+  out.report_files = io::lidar_camera_report_files("", rin, pairs, c, cam, shown);
+  report::finish_report(out, "lidar_camera.json");
+
+  // The camera placed from the LiDAR: T_b(camera) = T_b(lidar) T_camera_lidar^-1; every other
+  // camera keeps its pose relative to this one (the stereo extrinsic).
+  const SE3 T_b_cam_old = rig::sensor(rig, o.camera).T_base_sensor;
+  const SE3 T_b_cam = rig::sensor(rig, o.lidar).T_base_sensor * T.inverse();
+  for (rig::Sensor& other : rig.sensors) {
+    if (other.type == rig::SensorType::camera && other.name != o.camera) {
+      other.T_base_sensor = T_b_cam * T_b_cam_old.inverse() * other.T_base_sensor;
+      out.wrote.push_back(other.name);
+    }
+  }
+  rig::sensor(rig, o.camera).T_base_sensor = T_b_cam;
+  out.wrote.push_back(o.camera);
+  out.rig = rig;
+
+  size_t used = 0;
+  for (const PairOutcome& p : c.pairs) used += p.used;
+  out.residuals = {{"pairs_used", static_cast<double>(used), ""},
+                   {"pairs", static_cast<double>(c.pairs.size()), ""},
+                   {"noise_scale", s.noise_scale, ""},
+                   {"condition", s.observability.condition, ""}};
+  const std::string name = fmt::format("T_{}_{}", o.camera, o.lidar);
+  for (int a = 0; a < 3; ++a)
+    out.sigmas.push_back({fmt::format("{}.t.{}", name, "xyz"[a]), s.translation_sigma_m[a], "m"});
+  for (int a = 0; a < 3; ++a) {
+    out.sigmas.push_back(
+        {fmt::format("{}.rotation.{}", name, "xyz"[a]), s.rotation_sigma_deg[a], "deg"});
+  }
+  out.inputs.push_back({"target", in.target});
+  for (size_t k = 0; k < in.images.size(); ++k) {
+    out.inputs.push_back({"images", in.images[k]});
+    out.inputs.push_back({"scans", in.scans[k]});
+  }
+  return out;
+}
+
+}  // namespace rigcal::lidar_camera

@@ -1,0 +1,72 @@
+#pragma once
+// What every calibration step returns (calib/<step>/step.h), so that any caller (the command
+// line, the session pipeline, check, the tests) runs a step the same way and reads one answer:
+// the updated rig, the step's report as data (the JSON and its figures, not yet written), lines
+// for people, and a status. "The data do not determine this" is said one way: status
+// undetermined, with the reason and the data that would settle it. Bad input is not a status: it
+// raises rigcal::Error naming file, line or key.
+#include <filesystem>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "rigcal/io/files.h"
+#include "rigcal/rig/rig.h"
+
+namespace rigcal::report {
+
+enum class StepStatus { ok, undetermined };
+std::string_view to_string(StepStatus status);
+
+// A named figure of the estimate: a standard deviation or a residual statistic, with its unit.
+struct Figure {
+  std::string name;  // "cam_l.fx", "rms_px", "T_cam_r_lidar.t.x"
+  double value = 0;
+  std::string unit;  // "px", "m", "deg", "s", ""
+};
+
+// An input file or folder the step read (the session pipeline hashes them for provenance and
+// its cache).
+struct Input {
+  std::string role;  // "target", "images cam_l", "reference", ...
+  std::filesystem::path path;
+};
+
+struct StepResult {
+  std::string step;  // "cameras", "lidar_camera", "time_sync", "hand_eye"
+  StepStatus status = StepStatus::ok;
+  std::string reason;  // undetermined: what the data do not determine, and why
+  std::string remedy;  // undetermined: the data or option that would settle it
+  // The rig with this step's estimate written in (when undetermined: the rig as given).
+  rig::Rig rig;
+  // The sensors whose entries this step wrote (the pipeline copies exactly these).
+  std::vector<std::string> wrote;
+  // <step>.json and the figures beside it, paths relative to the report folder.
+  nlohmann::json report;
+  std::vector<io::OutputFile> report_files;
+  // Lines for people, in the order a terminal shows them; notes are what was assumed or noticed.
+  std::vector<std::string> summary, notes;
+  std::vector<Figure> sigmas, residuals;
+  std::vector<Input> inputs;
+};
+
+// Sets result.report from its JSON file among report_files (`json_file`), with the status (and
+// the reason and remedy when undetermined) added, and writes it back. Throws when it is absent.
+void finish_report(StepResult& result, std::string_view json_file);
+
+// The report's files under `dir`: <step>.json (the report with the status added) and the figures.
+std::vector<io::OutputFile> report_files_in(const StepResult& result,
+                                            const std::filesystem::path& dir);
+
+// Progress of long work: called with what is being done, items done and the total. Callers
+// decide how to show it (the command line: one updating line on a terminal, whole lines in a
+// log). An empty function shows nothing.
+using Progress = std::function<void(std::string_view what, size_t done, size_t total)>;
+inline void tell(const Progress& progress, std::string_view what, size_t done, size_t total) {
+  if (progress) progress(what, done, total);
+}
+
+}  // namespace rigcal::report

@@ -1,0 +1,425 @@
+#include "rigcal/session/calibrate.h"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <chrono>
+#include <map>
+
+#include "rigcal/core/error.h"
+#include "rigcal/core/sha256.h"
+#include "rigcal/core/version.h"
+#include "rigcal/io/files.h"
+#include "rigcal/io/image_sets.h"
+#include "rigcal/io/session.h"
+#include "rigcal/rig/rig_yaml.h"
+#include "rigcal/session/provenance.h"
+
+namespace rigcal::session {
+namespace fs = std::filesystem;
+namespace {
+
+// What the pipeline knows of a step before running it: where its inputs are, the rig entries it
+// reads, its options as text, and how to run it.
+struct Plan {
+  std::string step;
+  std::vector<std::string> depends_on;
+  std::vector<std::pair<std::string, fs::path>> inputs;  // role, path
+  std::vector<std::string> reads;                        // rig sensors
+  std::string options;
+  std::function<report::StepResult(const rig::Rig&, const report::Progress&)> run;
+  std::string cannot_plan;  // why it cannot run (a missing input), else ""
+};
+
+std::string fingerprint(const rig::Rig& rig, const std::vector<std::string>& sensors) {
+  std::string out;
+  for (const std::string& name : sensors) {
+    const rig::Sensor* s = rig::find_sensor(rig, name);
+    if (!s) {
+      out += name + ": absent\n";
+      continue;
+    }
+    rig::Rig one;
+    one.sensors = {*s};
+    one.sensors[0].attached_to.clear();
+    one.base_frame = name;
+    out += rig::rig_to_yaml(one);
+    out += "attached_to: " + s->attached_to + "\n";
+  }
+  return out;
+}
+
+std::vector<std::string> camera_names(const rig::Rig& rig) {
+  std::vector<std::string> out;
+  for (const rig::Sensor* c : rig::cameras(rig)) out.push_back(c->name);
+  return out;
+}
+
+nlohmann::json figures_json(const std::vector<report::Figure>& figures) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const report::Figure& f : figures)
+    j.push_back({{"name", f.name},
+                 {"value", std::isfinite(f.value) ? nlohmann::json(f.value) : nlohmann::json()},
+                 {"unit", f.unit}});
+  return j;
+}
+
+std::vector<report::Figure> figures_from(const nlohmann::json& j) {
+  std::vector<report::Figure> out;
+  for (const nlohmann::json& f : j)
+    out.push_back(
+        {f.at("name"), f.at("value").is_null() ? NAN : f.at("value").get<double>(), f.at("unit")});
+  return out;
+}
+
+// The cached result of a step: what StepRun shows, the rig it wrote and its inputs' hashes.
+struct Cached {
+  StepRun run;
+  rig::Rig rig;
+  std::vector<std::string> wrote;
+  std::vector<HashedInput> inputs;
+};
+
+nlohmann::json cache_json(const std::string& key, const StepRun& run, const rig::Rig& rig,
+                          const std::vector<std::string>& wrote,
+                          const std::vector<HashedInput>& inputs) {
+  nlohmann::json j;
+  j["key"] = key;
+  j["tool_version"] = version_string();
+  j["step"] = run.step;
+  j["status"] = run.status;
+  j["reason"] = run.reason;
+  j["remedy"] = run.remedy;
+  j["summary"] = run.summary;
+  j["notes"] = run.notes;
+  j["sigmas"] = figures_json(run.sigmas);
+  j["residuals"] = figures_json(run.residuals);
+  j["seconds"] = run.seconds;
+  j["wrote"] = wrote;
+  j["rig"] = rig::rig_to_yaml(rig);
+  j["inputs"] = nlohmann::json::array();
+  for (const HashedInput& in : inputs)
+    j["inputs"].push_back({{"role", in.role},
+                           {"path", in.path.string()},
+                           {"sha256", in.sha256},
+                           {"files", in.files}});
+  return j;
+}
+
+std::optional<Cached> read_cache(const fs::path& file, const std::string& key) {
+  if (!fs::exists(file)) return std::nullopt;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(io::read_text_file(file));
+    if (j.at("key") != key) return std::nullopt;
+    Cached c;
+    c.run.step = j.at("step");
+    c.run.status = j.at("status");
+    c.run.reason = j.at("reason");
+    c.run.remedy = j.at("remedy");
+    c.run.summary = j.at("summary").get<std::vector<std::string>>();
+    c.run.notes = j.at("notes").get<std::vector<std::string>>();
+    c.run.sigmas = figures_from(j.at("sigmas"));
+    c.run.residuals = figures_from(j.at("residuals"));
+    c.run.cached = true;
+    c.wrote = j.at("wrote").get<std::vector<std::string>>();
+    c.rig = rig::parse_rig_yaml(j.at("rig").get<std::string>(), file.string());
+    for (const nlohmann::json& in : j.at("inputs"))
+      c.inputs.push_back({in.at("role"), in.at("path").get<std::string>(), in.at("sha256"),
+                          in.at("files").get<size_t>()});
+    return c;
+  } catch (const std::exception&) {
+    return std::nullopt;  // a cache of another version or damaged: run again
+  }
+}
+
+// Writes the report folder whole: into a fresh sibling, then swapped in.
+void write_report_folder(const fs::path& dir, const std::vector<io::OutputFile>& files) {
+  const fs::path fresh = dir.string() + ".new";
+  fs::remove_all(fresh);
+  std::vector<io::OutputFile> placed;
+  for (const io::OutputFile& f : files) placed.push_back({fresh / f.path, f.content});
+  io::write_files_atomic(placed);
+  fs::create_directories(fresh);
+  fs::remove_all(dir);
+  fs::rename(fresh, dir);
+}
+
+std::vector<Plan> make_plans(const CalibrateOptions& o, const io::Session& s,
+                             const fs::path& target, const fs::path& out) {
+  std::vector<Plan> plans;
+  auto recording = [&](std::string_view purpose, Plan& p) -> fs::path {
+    try {
+      return io::recording_for(s, purpose);
+    } catch (const Error& e) {
+      p.cannot_plan = e.what();
+      return {};
+    }
+  };
+  auto need_target = [&](Plan& p) {
+    if (target.empty() && p.cannot_plan.empty())
+      p.cannot_plan = "no target: give --target T.yaml or name it in session.yaml (target: T.yaml)";
+    if (!target.empty()) p.inputs.emplace_back("target", target);
+  };
+  {
+    Plan p;
+    p.step = "cameras";
+    const fs::path rec = recording("cameras", p);
+    need_target(p);
+    for (const char* f : {"camera_left", "camera_right"}) {
+      if (!rec.empty() && fs::is_directory(rec / f)) p.inputs.emplace_back(f, rec / f);
+    }
+    p.reads = {"cam_l", "cam_r"};
+    p.options = fmt::format("model {} outlier_sigma {} bayer {}", o.cameras.model,
+                            o.cameras.outlier_sigma, io::to_string(o.cameras.bayer));
+    p.run = [rec, target, out, opt = o.cameras](const rig::Rig& rig, const report::Progress& pr) {
+      camera::StepInputs in;
+      in.target = target;
+      in.images = io::read_session_images(rec);
+      in.rig = rig;
+      in.corners_cache = out / "reports" / "cameras" / "corners.vnl";
+      return camera::calibrate_cameras(in, opt, pr);
+    };
+    plans.push_back(std::move(p));
+  }
+  {
+    Plan p;
+    p.step = "lidar_camera";
+    p.depends_on = {"cameras"};
+    const fs::path rec = recording("lidar_camera", p);
+    need_target(p);
+    const lidar_camera::StepOptions& lo = o.lidar_camera;
+    if (!rec.empty()) {
+      p.inputs.emplace_back("images",
+                            rec / (lo.camera == "cam_l" ? "camera_left" : "camera_right"));
+      p.inputs.emplace_back("scans", rec / "ouster_points");
+    }
+    p.options = fmt::format(
+        "camera {} lidar {} board {} {} roi {} corner_sigma {} max_dt {}", lo.camera, lo.lidar,
+        lo.board_width_m.value_or(0), lo.board_height_m.value_or(0),
+        lo.roi ? fmt::format("{} {}", fmt::join(lo.roi->first, ","), fmt::join(lo.roi->second, ","))
+               : "none",
+        lo.corner_sigma_px, lo.max_dt_s);
+    p.run = [rec, target, lo](const rig::Rig& rig, const report::Progress& pr) {
+      lidar_camera::StepInputs in = lidar_camera::pairs_from_recording(rec, rig, lo);
+      in.target = target;
+      in.rig_source = "the session's rig after the cameras step";
+      return lidar_camera::calibrate_lidar_camera(in, lo, pr);
+    };
+    plans.push_back(std::move(p));
+  }
+  {
+    Plan p;
+    p.step = "time_sync";
+    const fs::path rec = recording("motion", p);
+    if (!rec.empty()) {
+      p.inputs.emplace_back("reference", rec / "ouster_imu");
+      p.inputs.emplace_back("other", rec / "imu");
+    }
+    p.reads = {"os_imu", "imu"};
+    const time_sync::TimeSyncOptions& t = o.time_sync;
+    p.options = fmt::format(
+        "max_offset {} min_overlap {} window {} min_excitation {} three_axis {}", t.max_offset_s,
+        t.min_overlap, t.window_s, t.min_excitation_rad_s, t.three_axis);
+    p.run = [rec, t](const rig::Rig& rig, const report::Progress& pr) {
+      time_sync::StepInputs in = time_sync::streams_of_recording(rec);
+      in.rig = rig;
+      return time_sync::estimate_clock(in, t, pr);
+    };
+    plans.push_back(std::move(p));
+  }
+  {
+    Plan p;
+    p.step = "hand_eye";
+    const fs::path odometry = o.odometry.empty() ? s.odometry : o.odometry;
+    const fs::path gnss = o.gnss.empty() ? s.gnss : o.gnss;
+    if (odometry.empty())
+      p.cannot_plan =
+          "no LiDAR odometry: give --odometry FILE.tum (T_odom_lidar) or name it in session.yaml "
+          "(odometry: FILE)";
+    else if (gnss.empty())
+      p.cannot_plan =
+          "no GNSS/INS trajectory: give --gnss FILE, put it in the motion recording as "
+          "gnss/poses.tum or gnss/fixes.csv, or name it in session.yaml (gnss: FILE)";
+    if (!odometry.empty()) p.inputs.emplace_back("lidar odometry", odometry);
+    if (!gnss.empty()) p.inputs.emplace_back("gnss", gnss);
+    const hand_eye::StepOptions& h = o.hand_eye;
+    p.reads = {h.sensor, h.lidar_sensor};
+    std::string fixed;
+    for (const auto& f : h.refine.fixed)
+      fixed += fmt::format("[{} {} {}]={},{} ", f.direction.x(), f.direction.y(), f.direction.z(),
+                           f.value_m, f.sigma_m);
+    p.options = fmt::format(
+        "sensor {} lidar {} attitude {} spacings {} stride {} min_rotation {} smoothing {} "
+        "rotation_sigma {} translation_sigma {} max_sigma {} estimate_offset {} fixed {}",
+        h.sensor, h.lidar_sensor, h.attitude, fmt::join(h.pairs.spacings_s, ","), h.pairs.stride_s,
+        h.pairs.min_rotation_deg, h.pairs.gnss_half_window_s, h.refine.rotation_sigma_deg,
+        h.refine.translation_sigma_m, h.max_sigma_m, h.estimate_offset, fixed);
+    p.run = [odometry, gnss, h](const rig::Rig& rig, const report::Progress& pr) {
+      hand_eye::StepInputs in;
+      in.lidar = odometry;
+      in.gnss = gnss;
+      in.rig = rig;
+      in.rig_source = "the session's rig";
+      return hand_eye::estimate_extrinsic(in, h, pr);
+    };
+    plans.push_back(std::move(p));
+  }
+  return plans;
+}
+
+}  // namespace
+
+void check_step_name(std::string_view name) {
+  for (const char* s : kSteps) {
+    if (name == s) return;
+  }
+  throw Error(fmt::format("unknown step '{}': the steps are {}", name, fmt::join(kSteps, ", ")));
+}
+
+CalibrateResult calibrate(const CalibrateOptions& o, const Progress& progress) {
+  if (!o.from.empty()) check_step_name(o.from);
+  if (!o.only.empty()) check_step_name(o.only);
+  if (!o.from.empty() && !o.only.empty()) throw Error("give --from or --only, not both");
+  if (o.out.empty()) throw Error("--out: the output folder is needed");
+  const io::Session s = io::read_session(o.session);
+  const fs::path rig_file = o.rig.empty() ? s.rig : o.rig;
+  if (rig_file.empty()) {
+    throw Error(fmt::format(
+        "no prior rig: give --rig PRIOR.yaml or name it in {}/session.yaml (rig: FILE); it names "
+        "the sensors and holds what the steps do not estimate (data/sample_rig.yaml is an "
+        "example)",
+        o.session.string()));
+  }
+  const fs::path target = o.target.empty() ? s.target : o.target;
+  CalibrateResult result;
+  result.rig = rig::read_rig_file(rig_file);
+  // A GNSS/INS sensor's attached sensors are read (and written) by hand-eye too.
+  std::vector<Plan> plans = make_plans(o, s, target, o.out);
+  for (Plan& p : plans) {
+    if (p.step == "lidar_camera") {
+      p.reads = camera_names(result.rig);
+      p.reads.push_back(o.lidar_camera.lidar);
+    }
+    if (p.step == "hand_eye") {
+      rig::Rig probe = result.rig;
+      if (rig::find_sensor(probe, o.hand_eye.sensor)) {
+        for (const std::string& n : rig::move_rigidly(
+                 probe, o.hand_eye.sensor, rig::sensor(probe, o.hand_eye.sensor).T_base_sensor)) {
+          if (std::find(p.reads.begin(), p.reads.end(), n) == p.reads.end()) p.reads.push_back(n);
+        }
+      }
+    }
+  }
+
+  std::vector<StepRecord> records;
+  std::map<std::string, std::string> status_of;
+  bool before_from = !o.from.empty();
+  for (Plan& p : plans) {
+    if (p.step == o.from) before_from = false;
+    StepRun run;
+    run.step = p.step;
+    auto tell = [&](std::string_view what, size_t done, size_t total) {
+      report::tell(progress, fmt::format("[{}] {}", p.step, what), done, total);
+    };
+    const fs::path cache_file = o.out / "cache" / (p.step + ".json");
+    const fs::path report_dir = o.out / "reports" / p.step;
+    std::string blocked;
+    for (const std::string& d : p.depends_on) {
+      if (status_of[d] != "ok") blocked = fmt::format("needs {}, which is {}", d, status_of[d]);
+    }
+    // The key: the files it reads, the rig entries it reads, its options, this version.
+    std::vector<HashedInput> hashed;
+    std::string key;
+    if (p.cannot_plan.empty() && blocked.empty()) {
+      try {
+        for (const auto& [role, path] : p.inputs) {
+          hashed.push_back(hash_input(role, path));
+          tell("hashing the inputs", hashed.size(), p.inputs.size());
+        }
+        Sha256 k;
+        k.update(p.step + "\n" + version_string() + "\n" + p.options + "\n");
+        k.update(fingerprint(result.rig, p.reads));
+        for (const HashedInput& h : hashed) k.update(h.role + " " + h.sha256 + "\n");
+        key = k.hex();
+      } catch (const Error& e) {
+        p.cannot_plan = e.what();
+      }
+    }
+    std::optional<Cached> cached;
+    const bool forced = (!o.from.empty() && !before_from) || o.only == p.step;
+    if (!key.empty() && !forced && fs::exists(report_dir / (p.step + ".json")))
+      cached = read_cache(cache_file, key);
+    if (before_from && !cached) {
+      throw Error(fmt::format(
+          "--from {}: the earlier step {} has no cached result for these inputs in {}; run "
+          "without --from first",
+          o.from, p.step, (o.out / "cache").string()));
+    }
+    std::vector<std::string> wrote;
+    rig::Rig step_rig;
+    if (!o.only.empty() && o.only != p.step && !cached) {
+      run.status = "not run";
+      run.reason = fmt::format("--only {}", o.only);
+    } else if (!p.cannot_plan.empty()) {
+      run.status = "failed";
+      run.reason = p.cannot_plan;
+    } else if (!blocked.empty()) {
+      run.status = "blocked";
+      run.reason = blocked;
+    } else if (cached) {
+      run = cached->run;
+      step_rig = cached->rig;
+      wrote = cached->wrote;
+      hashed = cached->inputs;
+    } else {
+      const auto t0 = std::chrono::steady_clock::now();
+      try {
+        report::StepResult r = p.run(result.rig, tell);
+        run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        run.status = std::string(report::to_string(r.status));
+        run.reason = r.reason, run.remedy = r.remedy;
+        run.summary = r.summary, run.notes = r.notes;
+        run.sigmas = r.sigmas, run.residuals = r.residuals;
+        step_rig = r.rig;
+        wrote = r.wrote;
+        write_report_folder(report_dir, r.report_files);
+        io::write_file_atomic(cache_file,
+                              cache_json(key, run, step_rig, wrote, hashed).dump(2) + "\n");
+      } catch (const Error& e) {
+        run.status = "failed";
+        run.reason = e.what();
+        fs::remove(cache_file);
+        fs::remove_all(report_dir);
+      }
+    }
+    if (run.status == "ok") {
+      for (const std::string& name : wrote)
+        rig::sensor(result.rig, name) = rig::sensor(step_rig, name);
+      records.push_back(
+          {p.step, run.status, version_string(), "", hashed, run.sigmas, run.residuals});
+    }
+    status_of[p.step] = run.status;
+    result.steps.push_back(std::move(run));
+  }
+
+  bool failed = false, undetermined = false, all_ok = true;
+  for (const StepRun& r : result.steps) {
+    failed |= r.status == "failed" || r.status == "blocked";
+    undetermined |= r.status == "undetermined";
+    all_ok &= r.status == "ok";
+  }
+  result.exit_status = failed ? 2 : undetermined ? 3 : 0;
+  if (all_ok) {
+    auto& meta = result.rig.extra_metadata;
+    meta.erase(std::remove_if(meta.begin(), meta.end(),
+                              [](const auto& kv) { return kv.first == "steps"; }),
+               meta.end());
+    meta.emplace_back("steps", steps_yaml(records));
+    result.calibration = o.out / "calib.yaml";
+    io::write_file_atomic(result.calibration, rig::rig_to_yaml(result.rig));
+    result.published = true;
+  }
+  return result;
+}
+
+}  // namespace rigcal::session

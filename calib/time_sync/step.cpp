@@ -1,0 +1,126 @@
+#include "rigcal/time_sync/step.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "rigcal/core/error.h"
+#include "rigcal/core/se3.h"
+#include "rigcal/core/text.h"
+#include "rigcal/io/time_sync_report.h"
+
+namespace rigcal::time_sync {
+namespace fs = std::filesystem;
+
+StepInputs streams_of_recording(const fs::path& recording) {
+  if (!fs::is_directory(recording))
+    throw Error(fmt::format("{}: not a folder", recording.string()));
+  StepInputs in;
+  const fs::path dir = recording.lexically_normal();
+  in.reference.path = dir / "ouster_imu";
+  in.reference.sensor = "os_imu";
+  in.other.path = dir / "imu";
+  in.other.sensor = "imu";
+  return in;
+}
+
+report::StepResult estimate_clock(const StepInputs& in, const TimeSyncOptions& topt,
+                                  const report::Progress& progress) {
+  report::StepResult out;
+  out.step = "time_sync";
+  io::TimeSyncInputs rin;
+  rin.reference = in.reference.path.string(), rin.other = in.other.path.string();
+  rin.sensor = in.other.sensor, rin.reference_sensor = in.reference.sensor;
+  if (in.rig) {
+    if (!in.other.sensor.empty() && !rig::find_sensor(*in.rig, in.other.sensor))
+      throw Error(fmt::format("--sensor {}: no such sensor in the rig", in.other.sensor));
+    if (!in.reference.sensor.empty()) {
+      const rig::Sensor* ref = rig::find_sensor(*in.rig, in.reference.sensor);
+      if (!ref)
+        throw Error(
+            fmt::format("--reference-sensor {}: no such sensor in the rig", in.reference.sensor));
+      rin.reference_time_offset_s = ref->time_offset;
+    }
+  }
+  if (in.reference.sensor.empty())
+    rin.notes.push_back(
+        "no --reference-sensor: the reference stream is taken as on the base clock");
+
+  report::tell(progress, "reading the angular rates", 0, 2);
+  const io::RateFile ref = io::read_rates(in.reference.path, in.reference.read);
+  report::tell(progress, "reading the angular rates", 1, 2);
+  const io::RateFile oth = io::read_rates(in.other.path, in.other.read);
+  report::tell(progress, "reading the angular rates", 2, 2);
+  for (const auto* f : {&ref, &oth}) {
+    if (f->rates.stamps.size() < 2) {
+      throw Error(fmt::format("{}: {} samples; an angular-rate stream needs at least 10",
+                              (f == &ref ? in.reference.path : in.other.path).string(),
+                              f->rates.stamps.size()));
+    }
+  }
+  rin.reference_format = ref.format, rin.other_format = oth.format;
+  for (const std::string& n : ref.notes) rin.notes.push_back("reference: " + n);
+  for (const std::string& n : oth.notes) rin.notes.push_back("other: " + n);
+  out.summary.push_back(
+      fmt::format("reference {}: {} samples ({}), {:.1f} s", rin.reference, ref.rates.stamps.size(),
+                  ref.format, (ref.rates.stamps.back() - ref.rates.stamps.front()).seconds()));
+  out.summary.push_back(
+      fmt::format("other     {}: {} samples ({}), {:.1f} s", rin.other, oth.rates.stamps.size(),
+                  oth.format, (oth.rates.stamps.back() - oth.rates.stamps.front()).seconds()));
+
+  const TimeSyncResult r = estimate_time_offset(ref.rates, oth.rates, topt);
+  out.report_files = io::time_sync_report_files("", r, topt, rin, ref.rates, oth.rates);
+  out.notes = rin.notes;
+  out.inputs = {{"reference", in.reference.path}, {"other", in.other.path}};
+  out.rig = in.rig.value_or(rig::Rig{});
+  if (r.verdict != "ok") {
+    out.status = report::StepStatus::undetermined;
+    out.reason = fmt::format("no offset: {}: {}", r.verdict, r.reason);
+    out.remedy =
+        "record the two IMUs while turning the rig briskly about changing axes for a minute "
+        "(at least 0.05 rad/s of variation in the rate's magnitude), with both streams covering "
+        "the same time";
+    report::finish_report(out, "time_sync.json");
+    return out;
+  }
+
+  out.summary.push_back(
+      fmt::format("offset: t_reference = t_other + {:.6f} s (1-sigma {:.6f} s = {:.3f} ms)",
+                  r.offset_s, r.sigma_s, 1e3 * r.sigma_s));
+  out.summary.push_back(fmt::format(
+      "peak: NCC {:.3f}, second peak {:.3f} at {:+.4f} s (ratio {:.2f}); overlap {:.1f} s",
+      r.peak_ncc, r.second_peak_ncc, r.second_peak_offset_s, r.peak_ratio, r.overlap_s));
+  if (r.three_axis) {
+    const Eigen::Vector3d rpy = roll_pitch_yaw(r.R_reference_other) * 180.0 / M_PI;
+    out.summary.push_back(fmt::format(
+        "rotation other -> reference (roll pitch yaw): {:.3f} {:.3f} {:.3f} deg; residual RMS "
+        "{:.4f} rad/s",
+        rpy.x(), rpy.y(), rpy.z(), r.residual_rms_rad_s));
+  }
+  if (r.drift_estimated) {
+    out.summary.push_back(fmt::format(
+        "drift: {:.3f} ± {:.3f} ppm over {} windows of {:.0f} s: {}", r.drift_ppm,
+        r.drift_sigma_ppm, r.windows.size(), r.window_s,
+        r.drift_significant ? "significant (offset given at the epoch, the other stream's "
+                              "first stamp)"
+                            : "not significant"));
+  } else {
+    out.summary.push_back("drift: not estimated (fewer than 4 usable windows)");
+  }
+  if (in.rig && !in.other.sensor.empty()) {
+    rig::set_clock_from(out.rig, in.other.sensor, in.reference.sensor, r.offset_s,
+                        r.drift_significant ? r.drift_ppm : 0.0, r.epoch);
+    out.wrote.push_back(in.other.sensor);
+  }
+  const std::string who = in.other.sensor.empty() ? "other" : in.other.sensor;
+  out.sigmas.push_back({who + ".time_offset", r.sigma_s, "s"});
+  if (r.drift_estimated) out.sigmas.push_back({who + ".time_drift_ppm", r.drift_sigma_ppm, "ppm"});
+  out.residuals = {{"peak_ncc", r.peak_ncc, ""},
+                   {"peak_ratio", r.peak_ratio, ""},
+                   {"residual_rms_rad_s", r.residual_rms_rad_s, "rad/s"},
+                   {"overlap_s", r.overlap_s, "s"}};
+  report::finish_report(out, "time_sync.json");
+  return out;
+}
+
+}  // namespace rigcal::time_sync
