@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# `make demo`: the main job on the bundled sample. Today: check the sample rig's calibration YAML,
-# show it, and write it in every export format; then the calibration steps on a simulated session
-# (cameras, clock offset). Each calibration step extends this script.
+# `make demo`: the main job on the bundled sample. The sample rig's calibration YAML checked, shown
+# and exported; a trajectory scored; then a simulated session calibrated in one command
+# (`rigcal calibrate`) and published with two sequences (`rigcal publish`).
 set -euo pipefail
 build=${1:-build}
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -47,25 +47,22 @@ echo
   --est "$out/sim/trajectories/lidar_odometry.tum" | sed -n '1,8p'
 
 echo
-echo "== camera calibration of the simulated stereo images (truth: the sample rig)"
-"$rigcal" cameras --session "$out/sim/stereo" --target "$root/targets/a3_checkerboard_8x5_40mm.yaml" \
-  --rig "$sample" --out "$out/cameras/calib.yaml" --report "$out/cameras/report"
-echo "true values: cam_l fx 1085.3 fy 1084.7 cx 701.2 cy 349.6; baseline 0.4985 m (data/sample_rig.yaml)"
+echo "== the whole session calibrated in one command, from the prior rig a mounting drawing gives"
+echo "   (data/sample_prior_rig.yaml); $out/sim/session.yaml names which recording serves which step"
+"$rigcal" calibrate "$out/sim" --rig "$root/data/sample_prior_rig.yaml" --out "$out/session"
+echo
+echo "== the calibration against the truth (data/sample_rig.yaml)"
+"$rigcal" rig show "$out/session/calib.yaml" | sed -n '1,12p'
+echo "true: cam_l fx 1085.3 fy 1084.7 cx 701.2 cy 349.6; baseline 0.4985 m; imu and gnss offsets"
+echo "-3.1 ms; gnss at [-0.0512 0.0034 -0.1395] m (data/sample_rig.yaml)"
 
 echo
-echo "== clock offset between the simulated session's two IMUs (truth: imu time_offset -0.0031 s)"
-"$rigcal" time-offset --session "$out/sim" --rig "$out/cameras/calib.yaml" \
-  --out "$out/time_offset/calib.yaml" --report "$out/time_offset/report"
+echo "== a rerun with unchanged inputs reuses every step"
+"$rigcal" calibrate "$out/sim" --rig "$root/data/sample_prior_rig.yaml" --out "$out/session" | tail -n 7
 
 echo
-echo "== LiDAR-camera extrinsic from the simulated board pairs (truth: the sample rig's cam_r)"
-"$rigcal" lidar-camera --session "$out/sim" --target "$root/targets/a3_checkerboard_8x5_40mm.yaml" \
-  --rig "$out/time_offset/calib.yaml" --out "$out/lidar_camera/calib.yaml" \
-  --report "$out/lidar_camera/report"
-
-echo
-echo "== GNSS/INS-to-LiDAR extrinsic from the simulated trajectories (truth: the sample rig's gnss)"
-"$rigcal" hand-eye --lidar "$out/sim/trajectories/lidar_odometry.tum" \
-  --gnss "$out/sim/trajectories/gnss_ins.tum" --rig "$out/lidar_camera/calib.yaml" \
-  --estimate-offset --out "$out/hand_eye/calib.yaml" --report "$out/hand_eye/report"
-echo "The session's calibration, step by step: $out/hand_eye/calib.yaml"
+echo "== published with two recorded sequences (VBR layout: <place>/<seq>/vbr_calib.yaml)"
+mkdir -p "$out/vbr/campus/campus_train0" "$out/vbr/campus/campus_train1"
+"$rigcal" publish "$out/session/calib.yaml" "$out/vbr/campus/campus_train0" \
+  "$out/vbr/campus/campus_train1" --formats vbr,kalibr
+echo "The session's calibration: $out/session/calib.yaml (reports in $out/session/reports/)"
