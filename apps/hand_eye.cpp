@@ -8,13 +8,14 @@
 #include "rigcal/core/error.h"
 #include "rigcal/core/text.h"
 #include "rigcal/hand_eye/step.h"
+#include "rigcal/io/session.h"
 #include "step_output.h"
 
 namespace rigcal::cli {
 namespace {
 
 struct Options {
-  std::string lidar, gnss, sensor = "gnss", lidar_sensor = "lidar", rig, out, report;
+  std::string lidar, gnss, session, sensor = "gnss", lidar_sensor = "lidar", rig, out, report;
   std::string duplicates = "error", attitude;
   std::vector<std::string> fix;    // AXIS=VALUE, GNSS/INS frame
   std::vector<std::string> prior;  // AXIS=VALUE,SIGMA
@@ -76,6 +77,14 @@ void run(const Options& o) {
   so.estimate_offset = o.estimate_offset;
   hand_eye::StepInputs in;
   in.lidar = o.lidar, in.gnss = o.gnss, in.rig_source = o.rig;
+  if (!o.session.empty()) {  // what the session names, unless given
+    const io::Session s = io::read_session(o.session);
+    if (in.lidar.empty()) in.lidar = s.odometry;
+    if (in.gnss.empty()) in.gnss = s.gnss;
+  }
+  if (in.lidar.empty() || in.gnss.empty())
+    throw Error(
+        "give --lidar and --gnss, or a --session whose session.yaml names odometry and gnss");
   if (!o.rig.empty()) in.rig = rig::read_rig_file(o.rig);
   const report::StepResult r = hand_eye::estimate_extrinsic(in, so, console_progress());
   finish_step(r, o.out, o.report);
@@ -95,12 +104,14 @@ void add_hand_eye(CLI::App& app) {
       "free: give --fix z=METRES or --prior z=METRES,SIGMA, or the rig's value is kept and said\n"
       "so). Inputs: TUM, KITTI with times, EuRoC. Exit 0; 2 on bad input, 3 when a\n"
       "direction is undetermined and nothing fixes it: nothing written in either case.");
-  cmd->add_option("--lidar", o->lidar, "LiDAR odometry trajectory (T_odom_lidar)")->required();
+  cmd->add_option("--lidar", o->lidar, "LiDAR odometry trajectory (T_odom_lidar)");
   cmd->add_option("--gnss", o->gnss,
                   "GNSS/INS trajectory (T_enu_gnss; TUM, KITTI, EuRoC, OpenCalib), or a CSV of "
                   "fixes with a header (time, latitude, longitude, height, roll, pitch, yaw), on "
-                  "its own clock")
-      ->required();
+                  "its own clock");
+  cmd->add_option("--session", o->session,
+                  "a session or recording (doc/session.md): --lidar and --gnss from its "
+                  "session.yaml (odometry, gnss) or <motion>/gnss/, unless given");
   cmd->add_option("--attitude", o->attitude,
                   "GNSS fixes CSV only: enu (R = Rz(yaw) Ry(pitch) Rx(roll), yaw from east, "
                   "counter-clockwise) or ned (heading from north, clockwise; body x forward, z "

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <string>
 
+#include "devkit_layout.h"
 #include "rigcal/core/error.h"
 #include "rigcal/io/point_cloud_io.h"
 
@@ -16,19 +17,6 @@ namespace rigcal::io {
 namespace {
 
 namespace fs = std::filesystem;
-
-// The Ouster driver's point as vbr-devkit records it with --no-reduce-pcloud: 48 bytes.
-constexpr const char* kOusterMetadata = R"({"topic": "/os_cloud_node/points", "num_messages": 1,
- "msg_type": "PointCloudXf", "fields": [
- {"name": "x", "offset": 0, "datatype": 7, "count": 1},
- {"name": "y", "offset": 4, "datatype": 7, "count": 1},
- {"name": "z", "offset": 8, "datatype": 7, "count": 1},
- {"name": "intensity", "offset": 16, "datatype": 7, "count": 1},
- {"name": "t", "offset": 20, "datatype": 6, "count": 1},
- {"name": "reflectivity", "offset": 24, "datatype": 4, "count": 1},
- {"name": "ring", "offset": 26, "datatype": 4, "count": 1},
- {"name": "ambient", "offset": 28, "datatype": 4, "count": 1},
- {"name": "range", "offset": 32, "datatype": 6, "count": 1}]})";
 
 class PointCloudIo : public ::testing::Test {
  protected:
@@ -94,7 +82,7 @@ TEST_F(PointCloudIo, KittiBinWithoutMetadata) {
 // 384 points: 16 x 384 bytes is also a whole number of 48-byte records, so the reader must tell
 // the layouts apart by their content (rings), not by the size.
 TEST_F(PointCloudIo, VbrDevkitMetadataReducedAndFullLayouts) {
-  write("ouster_points/.metadata.json", kOusterMetadata);
+  write("ouster_points/.metadata.json", testing::ouster_metadata_json("/os_cloud_node/points", 1));
   const fs::path reduced = write("ouster_points/data/0000000000.bin", kitti_records(384));
   const fs::path full = write("ouster_points/data/0000000001.bin", full_records(384));
   expect_points(read_point_cloud(reduced), 384);

@@ -17,6 +17,7 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "devkit_layout.h"
 #include "rigcal/core/error.h"
 #include "rigcal/core/sha256.h"
 #include "rigcal/io/files.h"
@@ -57,34 +58,12 @@ CliRun rigcal_cli(const std::string& args, const fs::path& scratch) {
   return r;
 }
 
-// vbr-devkit's IMU_CSV_HEADER (python/vbr_devkit/datasets/kitti.py), repeated names included.
-constexpr const char* kDevkitImuHeader =
-    "acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z,quat_w,quat_x,quat_y,quat_z,"
-    "cov_acc_xx,cov_acc_xy,cov_acc_xz,cov_acc_yx,cov_acc_yy,cov_acc_zz,"
-    "cov_acc_zx,cov_acc_zy,cov_acc_zz,cov_gyr_xx,cov_gyr_xy,cov_gyr_xz,"
-    "cov_gyr_xx,cov_gyr_xy,cov_gyr_xz,cov_gyr_yx,cov_gyr_yy,cov_gyr_zz,"
-    "cov_rot_zx,cov_rot_zy,cov_rot_zz,cov_rot_yx,cov_rot_yy,cov_rot_zz,"
-    "cov_rot_zx,cov_rot_zy,cov_rot_zz";
-
-// The Ouster driver's point record as vbr-devkit stores it with --no-reduce-pcloud (48 bytes).
-constexpr const char* kOusterMetadata = R"({"topic": "/ouster/points", "num_messages": %zu,
- "msg_type": "PointCloudXf", "fields": [
- {"name": "x", "offset": 0, "datatype": 7, "count": 1},
- {"name": "y", "offset": 4, "datatype": 7, "count": 1},
- {"name": "z", "offset": 8, "datatype": 7, "count": 1},
- {"name": "intensity", "offset": 16, "datatype": 7, "count": 1},
- {"name": "t", "offset": 20, "datatype": 6, "count": 1},
- {"name": "reflectivity", "offset": 24, "datatype": 4, "count": 1},
- {"name": "ring", "offset": 26, "datatype": 4, "count": 1},
- {"name": "ambient", "offset": 28, "datatype": 4, "count": 1},
- {"name": "range", "offset": 32, "datatype": 6, "count": 1}]})";
-
 // The IMU CSV under the devkit's header: rigcal's simulator writes the same columns (acc, gyro,
 // quaternion wxyz, three covariances) under the ROS field names.
 void devkit_imu(const fs::path& topic) {
   const fs::path file = topic / "data" / "imu.txt";
   std::string text = slurp(file);
-  text = std::string(kDevkitImuHeader) + text.substr(text.find('\n'));
+  text = std::string(testing::kDevkitImuHeader) + text.substr(text.find('\n'));
   io::write_file_atomic(file, text);
 }
 
@@ -112,9 +91,8 @@ void devkit_points(const fs::path& topic) {
     ++n_files;
   }
   fs::remove_all(topic / "fields");
-  char meta[2048];
-  std::snprintf(meta, sizeof meta, kOusterMetadata, n_files);
-  io::write_file_atomic(topic / ".metadata.json", meta);
+  io::write_file_atomic(topic / ".metadata.json",
+                        testing::ouster_metadata_json("/ouster/points", n_files));
 }
 
 // The devkit's default image conversion (Bayer to RGB, written by cv2.imwrite): 3 channels.

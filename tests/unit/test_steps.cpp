@@ -163,6 +163,16 @@ TEST_F(Steps, HandEyeMovesTheInsImuWithIt) {
                   .isApprox(rig::T_a_b(*in.rig, "gnss", "imu").matrix(), 1e-12));
   EXPECT_EQ(r.report["status"], "ok");
 
+  // Not estimating the offset keeps the prior's (0 s, 3.1 ms off the truth), and says so.
+  o.estimate_offset = false;
+  const report::StepResult kept = hand_eye::estimate_extrinsic(in, o);
+  ASSERT_EQ(kept.status, report::StepStatus::ok);
+  EXPECT_EQ(rig::sensor(kept.rig, "gnss").time_offset, 0.0);
+  bool said = false;
+  for (const std::string& n : kept.notes) said |= n.find("put the clocks -3.") != std::string::npos;
+  EXPECT_TRUE(said) << "no note of the 3.1 ms disagreement";
+  o.estimate_offset = true;
+
   // Straight-line motion gives no clock offset: undetermined, nothing written.
   Trajectory line;
   for (int k = 0; k < 1000; ++k) {
