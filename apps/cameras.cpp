@@ -15,6 +15,7 @@
 #include "rigcal/camera/calibrate.h"
 #include "rigcal/camera/uncertainty.h"
 #include "rigcal/core/error.h"
+#include "rigcal/core/stats.h"
 #include "rigcal/core/text.h"
 #include "rigcal/core/time.h"
 #include "rigcal/core/version.h"
@@ -190,8 +191,7 @@ void run(const Options& o) {
   for (const auto& T : r.T_cam0_board) {
     if (T) distances.push_back(T->t.norm());
   }
-  std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
-  rep.uncertainty_distance_m = distances[distances.size() / 2];
+  rep.uncertainty_distance_m = median(distances);
   const int nk = static_cast<int>(r.cameras[0].stddev.size());
   for (size_t c = 0; c < n_cams; ++c) {
     rep.uncertainty.push_back(

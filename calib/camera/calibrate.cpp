@@ -8,6 +8,7 @@
 #include <opencv2/core/eigen.hpp>
 
 #include "rigcal/core/error.h"
+#include "rigcal/core/stats.h"
 
 namespace rigcal::camera {
 namespace {
@@ -113,8 +114,7 @@ SE3 from_rvec_tvec(const cv::Mat& rvec, const cv::Mat& tvec) {
 double mad_sigma(std::vector<double> v) {
   if (v.empty()) return 0.0;
   for (double& x : v) x = std::abs(x);
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return 1.4826 * v[v.size() / 2];
+  return 1.4826 * median(std::move(v));
 }
 
 // The distortion model as the cost functions take it: the intrinsics block is
@@ -229,12 +229,8 @@ std::vector<Pose> camera_poses(const std::vector<CameraInput>& cams,
           fmt::format("cameras {} and {} never see the target in the same frame: their relative "
                       "pose is unknown",
                       cams[0].name, cams[c].name));
-    auto med = [](std::vector<double> v) {
-      std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-      return v[v.size() / 2];
-    };
     cam_pose[c].q.coeffs() = q_sum.normalized();  // the normalized mean of aligned quaternions
-    cam_pose[c].t = Eigen::Vector3d(med(tx), med(ty), med(tz));
+    cam_pose[c].t = Eigen::Vector3d(median(tx), median(ty), median(tz));
   }
   return cam_pose;
 }
