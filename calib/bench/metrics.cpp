@@ -105,11 +105,6 @@ Matches associate_by_index(const Trajectory& gt, const Trajectory& est) {
   return m;
 }
 
-SE3 interpolate(const SE3& T_a, const SE3& T_b, double fraction) {
-  const Eigen::Quaterniond q = T_a.quaternion().slerp(fraction, T_b.quaternion());
-  return SE3::from_quaternion(q, (1.0 - fraction) * T_a.t + fraction * T_b.t);
-}
-
 Interpolated interpolate_gt(const Trajectory& gt, const Trajectory& est, Time max_gap) {
   Interpolated out;
   size_t j = 0;  // first GT stamp >= the estimate stamp

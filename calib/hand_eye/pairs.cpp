@@ -6,26 +6,13 @@
 #include <cmath>
 #include <optional>
 
-#include "rigcal/bench/metrics.h"
 #include "rigcal/core/error.h"
 #include "rigcal/core/stats.h"
+#include "rigcal/core/trajectory.h"
 #include "rigcal/hand_eye/hand_eye.h"
 
 namespace rigcal::hand_eye {
 namespace {
-
-// The pose of `traj` at t, interpolated inside an interval no longer than max_gap.
-std::optional<SE3> pose_at(const Trajectory& traj, Time t, Time max_gap) {
-  const auto it = std::lower_bound(traj.stamps.begin(), traj.stamps.end(), t);
-  if (it == traj.stamps.end()) return std::nullopt;
-  const size_t j = static_cast<size_t>(it - traj.stamps.begin());
-  if (*it == t) return traj.T_world_body[j];
-  if (j == 0) return std::nullopt;
-  const Time a = traj.stamps[j - 1], b = traj.stamps[j];
-  if (b - a > max_gap) return std::nullopt;
-  return bench::interpolate(traj.T_world_body[j - 1], traj.T_world_body[j],
-                            (t - a).seconds() / (b - a).seconds());
-}
 
 // The body-frame angular and linear velocity of `traj` at t, by central differences over +-50 ms
 // (one LiDAR period); zero where the poses are not there.
