@@ -8,6 +8,7 @@
 #include <numeric>
 
 #include "rigcal/core/error.h"
+#include "rigcal/core/stats.h"
 
 namespace rigcal::bench {
 
@@ -30,16 +31,7 @@ Stats statistics(const std::vector<double>& values) {
   double var = 0.0;
   for (double v : values) var += (v - s.mean) * (v - s.mean);
   s.std = std::sqrt(var / n);
-  std::vector<double> sorted = values;
-  const size_t mid = sorted.size() / 2;
-  std::nth_element(sorted.begin(), sorted.begin() + mid, sorted.end());
-  if (sorted.size() % 2 == 1) {
-    s.median = sorted[mid];
-  } else {
-    const double upper = sorted[mid];
-    const double lower = *std::max_element(sorted.begin(), sorted.begin() + mid);
-    s.median = 0.5 * (lower + upper);
-  }
+  s.median = median_midpoint(values);
   return s;
 }
 
@@ -111,11 +103,6 @@ Matches associate_by_index(const Trajectory& gt, const Trajectory& est) {
   std::iota(m.gt.begin(), m.gt.end(), 0);
   std::iota(m.est.begin(), m.est.end(), 0);
   return m;
-}
-
-SE3 interpolate(const SE3& T_a, const SE3& T_b, double fraction) {
-  const Eigen::Quaterniond q = T_a.quaternion().slerp(fraction, T_b.quaternion());
-  return SE3::from_quaternion(q, (1.0 - fraction) * T_a.t + fraction * T_b.t);
 }
 
 Interpolated interpolate_gt(const Trajectory& gt, const Trajectory& est, Time max_gap) {

@@ -36,8 +36,8 @@ struct Interpolated {
   std::vector<size_t> est;
   std::vector<SE3> T_world_gt;
 };
+// (rigcal::interpolate, core/trajectory.h, between the two GT poses.)
 Interpolated interpolate_gt(const Trajectory& gt, const Trajectory& est, Time max_gap);
-SE3 interpolate(const SE3& T_a, const SE3& T_b, double fraction);
 
 // ---- alignment ----------------------------------------------------------------------------------
 enum class Alignment { se3, sim3, yaw, origin, none };

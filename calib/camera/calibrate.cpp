@@ -8,6 +8,7 @@
 #include <opencv2/core/eigen.hpp>
 
 #include "rigcal/core/error.h"
+#include "rigcal/core/stats.h"
 
 namespace rigcal::camera {
 namespace {
@@ -113,20 +114,26 @@ SE3 from_rvec_tvec(const cv::Mat& rvec, const cv::Mat& tvec) {
 double mad_sigma(std::vector<double> v) {
   if (v.empty()) return 0.0;
   for (double& x : v) x = std::abs(x);
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return 1.4826 * v[v.size() / 2];
+  return 1.4826 * median(std::move(v));
 }
 
-}  // namespace
+// The distortion model as the cost functions take it: the intrinsics block is
+// [fx fy cx cy d...] with n_coeffs distortion coefficients.
+struct Lens {
+  bool radtan = true;
+  int n_coeffs = 4;
+  int intrinsics_size() const { return 4 + n_coeffs; }
+};
 
-std::vector<double> intrinsics_vector(const rig::CameraModel& m) {
-  std::vector<double> k = {m.fx, m.fy, m.cx, m.cy};
-  k.insert(k.end(), m.distortion_coeffs.begin(), m.distortion_coeffs.end());
-  return k;
-}
+// The parameters of the joint problem, changed in place by the solves.
+struct Parameters {
+  std::vector<std::vector<double>> intr;   // per camera: its intrinsics block
+  std::vector<Pose> cam_pose;              // per camera: T_c_0 (camera 0: identity, not solved)
+  std::vector<std::optional<Pose>> board;  // per frame: T_0_board (none: no camera saw it)
+};
 
-CalibrationResult calibrate(const Target& target, const std::vector<CameraInput>& cams,
-                            const CalibrationOptions& opt) {
+// Throws rigcal::Error without cameras or when they differ in frame count.
+void check_frames_pair_up(const std::vector<CameraInput>& cams) {
   if (cams.empty()) throw Error("no camera to calibrate");
   const size_t n_frames = cams[0].frames.size();
   for (const CameraInput& c : cams) {
@@ -135,62 +142,74 @@ CalibrationResult calibrate(const Target& target, const std::vector<CameraInput>
                               c.name, c.frames.size(), cams[0].name, n_frames));
     }
   }
+}
+
+// Throws rigcal::Error on a radtan model of neither 4 nor 5 coefficients.
+Lens lens_of(const CalibrationOptions& opt) {
   const bool radtan = opt.model == rig::DistortionModel::radtan;
   const int n_coeffs = radtan ? opt.radtan_coefficients : 4;
   if (radtan && n_coeffs != 4 && n_coeffs != 5) throw Error("radtan takes 4 or 5 coefficients");
-  const int NK = 4 + n_coeffs;
-  const std::vector<Eigen::Vector3d> object = object_points(target);
+  return {radtan, n_coeffs};
+}
 
-  // ---- initialization, per camera: OpenCV's calibration gives intrinsics and board poses ----
-  std::vector<std::vector<double>> intr(cams.size());
-  std::vector<std::vector<std::optional<SE3>>> T_c_board(cams.size(),
-                                                         std::vector<std::optional<SE3>>(n_frames));
-  for (size_t c = 0; c < cams.size(); ++c) {
-    std::vector<std::vector<cv::Point3f>> obj;
-    std::vector<std::vector<cv::Point2f>> img;
-    std::vector<size_t> frame_of;
-    for (size_t f = 0; f < n_frames; ++f) {
-      const Detection& d = cams[c].frames[f];
-      if (!d.found || d.pixels.size() < 6) continue;
-      obj.emplace_back();
-      img.emplace_back();
-      for (size_t i = 0; i < d.pixels.size(); ++i) {
-        const Eigen::Vector3d& p = object[d.point_ids[i]];
-        obj.back().emplace_back(p.x(), p.y(), p.z());
-        img.back().emplace_back(d.pixels[i].x(), d.pixels[i].y());
-      }
-      frame_of.push_back(f);
+// One camera alone by OpenCV's calibration: its initial intrinsics block, and in T_c_board the
+// board pose of every frame with a usable detection (6 corners or more). Throws rigcal::Error
+// with fewer than min_views such frames or when the calibration diverges.
+std::vector<double> initial_intrinsics(const CameraInput& cam,
+                                       const std::vector<Eigen::Vector3d>& object, const Lens& lens,
+                                       int min_views, std::vector<std::optional<SE3>>& T_c_board) {
+  const size_t n_frames = cam.frames.size();
+  const bool radtan = lens.radtan;
+  const int n_coeffs = lens.n_coeffs;
+  std::vector<std::vector<cv::Point3f>> obj;
+  std::vector<std::vector<cv::Point2f>> img;
+  std::vector<size_t> frame_of;
+  for (size_t f = 0; f < n_frames; ++f) {
+    const Detection& d = cam.frames[f];
+    if (!d.found || d.pixels.size() < 6) continue;
+    obj.emplace_back();
+    img.emplace_back();
+    for (size_t i = 0; i < d.pixels.size(); ++i) {
+      const Eigen::Vector3d& p = object[d.point_ids[i]];
+      obj.back().emplace_back(p.x(), p.y(), p.z());
+      img.back().emplace_back(d.pixels[i].x(), d.pixels[i].y());
     }
-    if (static_cast<int>(obj.size()) < opt.min_views) {
-      throw Error(fmt::format("camera {}: {} usable views of the target; at least {} are needed",
-                              cams[c].name, obj.size(), opt.min_views));
-    }
-    const cv::Size size(cams[c].width, cams[c].height);
-    cv::Mat K = cv::Mat::eye(3, 3, CV_64F), D;
-    std::vector<cv::Mat> rvecs, tvecs;
-    // Pinhole with radial k1 k2 (no tangential, no k3) is a safe start for both models: Ceres
-    // then frees every coefficient. No interactive guesses, no NaN seeds.
-    const int flags = cv::CALIB_ZERO_TANGENT_DIST | cv::CALIB_FIX_K3;
-    cv::calibrateCamera(
-        obj, img, size, K, D, rvecs, tvecs, flags,
-        cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, 1e-9));
-    std::vector<double> k = {K.at<double>(0, 0), K.at<double>(1, 1), K.at<double>(0, 2),
-                             K.at<double>(1, 2)};
-    if (radtan) {
-      k.insert(k.end(), {D.at<double>(0), D.at<double>(1), 0.0, 0.0});
-      if (n_coeffs == 5) k.push_back(0.0);
-    } else {
-      k.insert(k.end(), {0.0, 0.0, 0.0, 0.0});
-    }
-    for (double v : k) {
-      if (!std::isfinite(v))
-        throw Error(fmt::format("camera {}: the initial calibration diverged", cams[c].name));
-    }
-    intr[c] = k;
-    for (size_t i = 0; i < frame_of.size(); ++i)
-      T_c_board[c][frame_of[i]] = from_rvec_tvec(rvecs[i], tvecs[i]);
+    frame_of.push_back(f);
   }
-  // Other cameras in camera 0: the average over shared frames.
+  if (static_cast<int>(obj.size()) < min_views) {
+    throw Error(fmt::format("camera {}: {} usable views of the target; at least {} are needed",
+                            cam.name, obj.size(), min_views));
+  }
+  const cv::Size size(cam.width, cam.height);
+  cv::Mat K = cv::Mat::eye(3, 3, CV_64F), D;
+  std::vector<cv::Mat> rvecs, tvecs;
+  // Pinhole with radial k1 k2 (no tangential, no k3) is a safe start for both models: Ceres
+  // then frees every coefficient. No interactive guesses, no NaN seeds.
+  const int flags = cv::CALIB_ZERO_TANGENT_DIST | cv::CALIB_FIX_K3;
+  cv::calibrateCamera(obj, img, size, K, D, rvecs, tvecs, flags,
+                      cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, 1e-9));
+  std::vector<double> k = {K.at<double>(0, 0), K.at<double>(1, 1), K.at<double>(0, 2),
+                           K.at<double>(1, 2)};
+  if (radtan) {
+    k.insert(k.end(), {D.at<double>(0), D.at<double>(1), 0.0, 0.0});
+    if (n_coeffs == 5) k.push_back(0.0);
+  } else {
+    k.insert(k.end(), {0.0, 0.0, 0.0, 0.0});
+  }
+  for (double v : k) {
+    if (!std::isfinite(v))
+      throw Error(fmt::format("camera {}: the initial calibration diverged", cam.name));
+  }
+  T_c_board.assign(n_frames, std::nullopt);
+  for (size_t i = 0; i < frame_of.size(); ++i)
+    T_c_board[frame_of[i]] = from_rvec_tvec(rvecs[i], tvecs[i]);
+  return k;
+}
+
+// T_c_0 of every camera (camera 0: identity): the average over the frames both see.
+std::vector<Pose> camera_poses(const std::vector<CameraInput>& cams,
+                               const std::vector<std::vector<std::optional<SE3>>>& T_c_board) {
+  const size_t n_frames = cams[0].frames.size();
   std::vector<Pose> cam_pose(cams.size());
   for (size_t c = 1; c < cams.size(); ++c) {
     Eigen::Vector4d q_sum = Eigen::Vector4d::Zero();
@@ -210,31 +229,39 @@ CalibrationResult calibrate(const Target& target, const std::vector<CameraInput>
           fmt::format("cameras {} and {} never see the target in the same frame: their relative "
                       "pose is unknown",
                       cams[0].name, cams[c].name));
-    auto med = [](std::vector<double> v) {
-      std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-      return v[v.size() / 2];
-    };
     cam_pose[c].q.coeffs() = q_sum.normalized();  // the normalized mean of aligned quaternions
-    cam_pose[c].t = Eigen::Vector3d(med(tx), med(ty), med(tz));
+    cam_pose[c].t = Eigen::Vector3d(median(tx), median(ty), median(tz));
   }
+  return cam_pose;
+}
+
+// T_0_board of every frame: camera 0's, else that of the first other camera that saw it.
+std::vector<std::optional<Pose>> board_poses(
+    const std::vector<std::vector<std::optional<SE3>>>& T_c_board,
+    const std::vector<Pose>& cam_pose) {
+  const size_t n_frames = T_c_board[0].size();
   std::vector<std::optional<Pose>> board(n_frames);
   for (size_t f = 0; f < n_frames; ++f) {
     if (T_c_board[0][f]) {
       board[f] = Pose::from(*T_c_board[0][f]);
       continue;
     }
-    for (size_t c = 1; c < cams.size(); ++c) {
+    for (size_t c = 1; c < cam_pose.size(); ++c) {
       if (T_c_board[c][f]) {
         board[f] = Pose::from(cam_pose[c].se3().inverse() * *T_c_board[c][f]);
         break;
       }
     }
   }
+  return board;
+}
 
-  // ---- the joint problem, with outlier rejection ----
-  CalibrationResult res;
+// One residual a detected corner of a frame with a board pose.
+std::vector<CornerResidual> corner_residuals(const std::vector<CameraInput>& cams,
+                                             const std::vector<std::optional<Pose>>& board) {
+  std::vector<CornerResidual> residuals;
   for (size_t c = 0; c < cams.size(); ++c) {
-    for (size_t f = 0; f < n_frames; ++f) {
+    for (size_t f = 0; f < cams[c].frames.size(); ++f) {
       const Detection& d = cams[c].frames[f];
       if (!d.found || !board[f]) continue;
       for (size_t i = 0; i < d.pixels.size(); ++i) {
@@ -243,80 +270,99 @@ CalibrationResult calibrate(const Target& target, const std::vector<CameraInput>
         cr.frame = static_cast<int>(f);
         cr.point = d.point_ids[i];
         cr.observed = d.pixels[i];
-        res.residuals.push_back(cr);
+        residuals.push_back(cr);
       }
     }
   }
-  auto solve = [&](bool robust, ceres::Problem* out_problem) {
-    ceres::Problem::Options po;
-    ceres::Problem local(po);
-    ceres::Problem& problem = out_problem ? *out_problem : local;
-    for (const CornerResidual& cr : res.residuals) {
-      if (cr.outlier) continue;
-      const Eigen::Vector3d& p = object[cr.point];
-      ceres::CostFunction* cost = NK == 8 ? make_cost<8>(cr.camera, p, cr.observed, radtan)
-                                          : make_cost<9>(cr.camera, p, cr.observed, radtan);
-      ceres::LossFunction* loss = robust ? new ceres::HuberLoss(opt.huber_px) : nullptr;
-      Pose& b = *board[cr.frame];
-      if (cr.camera == 0) {
-        problem.AddResidualBlock(cost, loss, intr[0].data(), b.q.coeffs().data(), b.t.data());
-      } else {
-        Pose& cp = cam_pose[cr.camera];
-        problem.AddResidualBlock(cost, loss, intr[cr.camera].data(), b.q.coeffs().data(),
-                                 b.t.data(), cp.q.coeffs().data(), cp.t.data());
-      }
+  return residuals;
+}
+
+// One solve of the joint problem over the inlier corners, in `problem` (robust: Huber loss of
+// huber_px). Throws rigcal::Error when the solution is not usable.
+void solve(const std::vector<CornerResidual>& residuals, const std::vector<Eigen::Vector3d>& object,
+           const Lens& lens, bool robust, double huber_px, Parameters& x, ceres::Problem& problem) {
+  const bool radtan = lens.radtan;
+  const int NK = lens.intrinsics_size();
+  std::vector<std::vector<double>>& intr = x.intr;
+  std::vector<Pose>& cam_pose = x.cam_pose;
+  std::vector<std::optional<Pose>>& board = x.board;
+  for (const CornerResidual& cr : residuals) {
+    if (cr.outlier) continue;
+    const Eigen::Vector3d& p = object[cr.point];
+    ceres::CostFunction* cost = NK == 8 ? make_cost<8>(cr.camera, p, cr.observed, radtan)
+                                        : make_cost<9>(cr.camera, p, cr.observed, radtan);
+    ceres::LossFunction* loss = robust ? new ceres::HuberLoss(huber_px) : nullptr;
+    Pose& b = *board[cr.frame];
+    if (cr.camera == 0) {
+      problem.AddResidualBlock(cost, loss, intr[0].data(), b.q.coeffs().data(), b.t.data());
+    } else {
+      Pose& cp = cam_pose[cr.camera];
+      problem.AddResidualBlock(cost, loss, intr[cr.camera].data(), b.q.coeffs().data(), b.t.data(),
+                               cp.q.coeffs().data(), cp.t.data());
     }
-    for (auto& b : board) {
-      if (b && problem.HasParameterBlock(b->q.coeffs().data())) {
-        problem.SetManifold(b->q.coeffs().data(), new ceres::EigenQuaternionManifold);
-      }
+  }
+  for (auto& b : board) {
+    if (b && problem.HasParameterBlock(b->q.coeffs().data())) {
+      problem.SetManifold(b->q.coeffs().data(), new ceres::EigenQuaternionManifold);
     }
-    for (size_t c = 1; c < cams.size(); ++c) {
-      if (problem.HasParameterBlock(cam_pose[c].q.coeffs().data())) {
-        problem.SetManifold(cam_pose[c].q.coeffs().data(), new ceres::EigenQuaternionManifold);
-      }
+  }
+  for (size_t c = 1; c < cam_pose.size(); ++c) {
+    if (problem.HasParameterBlock(cam_pose[c].q.coeffs().data())) {
+      problem.SetManifold(cam_pose[c].q.coeffs().data(), new ceres::EigenQuaternionManifold);
     }
-    ceres::Solver::Options so;
-    so.linear_solver_type = ceres::SPARSE_SCHUR;
-    so.max_num_iterations = 200;
-    so.function_tolerance = 1e-12;
-    so.parameter_tolerance = 1e-12;
-    so.num_threads = 1;  // deterministic sums: the same corners give the same calibration
-    ceres::Solver::Summary summary;
-    ceres::Solve(so, &problem, &summary);
-    if (!summary.IsSolutionUsable())
-      throw Error("the calibration solve failed: " + summary.BriefReport());
-  };
-  auto update_residuals = [&] {
-    for (CornerResidual& cr : res.residuals) {
-      const Pose& b = *board[cr.frame];
-      Eigen::Vector3d p = b.q * object[cr.point] + b.t;
-      if (cr.camera > 0) p = cam_pose[cr.camera].q * p + cam_pose[cr.camera].t;
-      Eigen::Vector2d uv;
-      project(intr[cr.camera].data(), radtan, n_coeffs, p.data(), uv.data());
-      cr.residual = uv - cr.observed;
-    }
-  };
+  }
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::SPARSE_SCHUR;
+  so.max_num_iterations = 200;
+  so.function_tolerance = 1e-12;
+  so.parameter_tolerance = 1e-12;
+  so.num_threads = 1;  // deterministic sums: the same corners give the same calibration
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &problem, &summary);
+  if (!summary.IsSolutionUsable())
+    throw Error("the calibration solve failed: " + summary.BriefReport());
+}
+
+// Every corner's residual (outliers too) at the parameters x.
+void update_residuals(std::vector<CornerResidual>& residuals,
+                      const std::vector<Eigen::Vector3d>& object, const Lens& lens,
+                      const Parameters& x) {
+  for (CornerResidual& cr : residuals) {
+    const Pose& b = *x.board[cr.frame];
+    Eigen::Vector3d p = b.q * object[cr.point] + b.t;
+    if (cr.camera > 0) p = x.cam_pose[cr.camera].q * p + x.cam_pose[cr.camera].t;
+    Eigen::Vector2d uv;
+    project(x.intr[cr.camera].data(), lens.radtan, lens.n_coeffs, p.data(), uv.data());
+    cr.residual = uv - cr.observed;
+  }
+}
+
+// Robust solves, each followed by flagging the corners with a coordinate beyond
+// outlier_k_sigma robust sigmas, until none is flagged or max_rejection_rounds.
+void reject_outliers(std::vector<CornerResidual>& residuals,
+                     const std::vector<Eigen::Vector3d>& object, const Lens& lens,
+                     const CalibrationOptions& opt, Parameters& x) {
   for (int round = 0; round < opt.max_rejection_rounds; ++round) {
-    solve(true, nullptr);
-    update_residuals();
+    ceres::Problem problem;
+    solve(residuals, object, lens, true, opt.huber_px, x, problem);
+    update_residuals(residuals, object, lens, x);
     std::vector<double> coords;
-    for (const CornerResidual& cr : res.residuals) {
+    for (const CornerResidual& cr : residuals) {
       if (!cr.outlier) coords.push_back(cr.residual.x()), coords.push_back(cr.residual.y());
     }
     const double sigma = mad_sigma(coords);
     size_t dropped = 0;
-    for (CornerResidual& cr : res.residuals) {
+    for (CornerResidual& cr : residuals) {
       if (!cr.outlier && cr.residual.cwiseAbs().maxCoeff() > opt.outlier_k_sigma * sigma)
         cr.outlier = true, ++dropped;
     }
     if (dropped == 0) break;
   }
-  // Final: plain least squares on the inliers, kept for the covariance.
-  ceres::Problem problem;
-  solve(false, &problem);
-  update_residuals();
+}
 
+// The residual statistics of the inliers, the parameter count and the noise level.
+void fit_statistics(CalibrationResult& res, size_t n_cams, int NK,
+                    const std::vector<std::optional<Pose>>& board) {
   double sse = 0.0;
   size_t n_in = 0;
   for (const CornerResidual& cr : res.residuals) {
@@ -330,19 +376,27 @@ CalibrationResult calibrate(const Target& target, const std::vector<CameraInput>
   res.rms_2d_px = std::sqrt(sse / n_in);
   res.rms_coord_px = std::sqrt(sse / (2.0 * n_in));
   res.n_residuals = 2 * n_in;
-  res.n_parameters = cams.size() * NK + 6 * (cams.size() - 1);
+  res.n_parameters = n_cams * NK + 6 * (n_cams - 1);
   for (const auto& b : board) res.n_parameters += b ? 6 : 0;
   const double dof = static_cast<double>(res.n_residuals) - static_cast<double>(res.n_parameters);
   res.noise_sigma_px = std::sqrt(sse / std::max(1.0, dof));
+}
 
-  // Covariance of intrinsics, camera poses and board poses, scaled by the estimated noise.
+// The covariance of intrinsics, camera poses and board poses (res.covariance,
+// res.board_covariance_index), scaled by the estimated noise; a note when it cannot be computed.
+void add_covariance(CalibrationResult& res, ceres::Problem& problem, size_t n_cams, int NK,
+                    Parameters& x) {
+  const size_t n_frames = x.board.size();
+  std::vector<std::vector<double>>& intr = x.intr;
+  std::vector<Pose>& cam_pose = x.cam_pose;
+  std::vector<std::optional<Pose>>& board = x.board;
   std::vector<const double*> blocks;
-  for (size_t c = 0; c < cams.size(); ++c) blocks.push_back(intr[c].data());
-  for (size_t c = 1; c < cams.size(); ++c) {
+  for (size_t c = 0; c < n_cams; ++c) blocks.push_back(intr[c].data());
+  for (size_t c = 1; c < n_cams; ++c) {
     blocks.push_back(cam_pose[c].q.coeffs().data());
     blocks.push_back(cam_pose[c].t.data());
   }
-  int n_cov = static_cast<int>(cams.size()) * NK + 6 * (static_cast<int>(cams.size()) - 1);
+  int n_cov = static_cast<int>(n_cams) * NK + 6 * (static_cast<int>(n_cams) - 1);
   res.board_covariance_index.assign(n_frames, -1);
   for (size_t f = 0; f < n_frames; ++f) {
     if (!board[f] || !problem.HasParameterBlock(board[f]->q.coeffs().data())) continue;
@@ -373,47 +427,95 @@ CalibrationResult calibrate(const Target& target, const std::vector<CameraInput>
     res.notes.push_back(
         "the covariance could not be computed (rank-deficient problem): the data do not determine "
         "every parameter");
+}
+
+// Camera c's model, intrinsics stddev and per-view RMS.
+CameraResult camera_result(const CalibrationResult& res, const CameraInput& cam, size_t c, int NK,
+                           const std::vector<double>& intr, rig::DistortionModel model) {
+  const size_t n_frames = cam.frames.size();
+  CameraResult cr;
+  rig::CameraModel& m = cr.model;
+  m.fx = intr[0], m.fy = intr[1], m.cx = intr[2], m.cy = intr[3];
+  m.distortion_model = model;
+  m.distortion_coeffs.assign(intr.begin() + 4, intr.end());
+  m.width = cam.width;
+  m.height = cam.height;
+  for (int i = 0; i < NK; ++i)
+    cr.stddev.push_back(std::sqrt(std::max(0.0, res.covariance(c * NK + i, c * NK + i))));
+  std::vector<double> sse_f(n_frames, 0.0);
+  std::vector<int> n_f(n_frames, 0);
+  for (const CornerResidual& r : res.residuals) {
+    if (r.camera != static_cast<int>(c) || r.outlier) continue;
+    sse_f[r.frame] += r.residual.squaredNorm();
+    ++n_f[r.frame];
+    ++cr.n_corners;
+  }
+  for (size_t f = 0; f < n_frames; ++f) {
+    cr.view_rms.push_back(n_f[f] ? std::sqrt(sse_f[f] / n_f[f]) : NAN);
+    cr.n_views += n_f[f] > 0;
+  }
+  return cr;
+}
+
+// T_cam_cam0 of camera c and its 1-sigma in deg and m (camera 0: identity, 0).
+void add_camera_pose(CalibrationResult& res, size_t c, size_t n_cams, int NK,
+                     const std::vector<Pose>& cam_pose) {
+  res.T_cam_cam0.push_back(c == 0 ? SE3() : cam_pose[c].se3());
+  if (c == 0) {
+    res.rotation_stddev_deg.emplace_back(0, 0, 0);
+    res.translation_stddev_m.emplace_back(0, 0, 0);
+  } else {
+    const int base = static_cast<int>(n_cams) * NK + 6 * (static_cast<int>(c) - 1);
+    Eigen::Vector3d r, t;
+    for (int i = 0; i < 3; ++i) {
+      // Ceres' quaternion tangent: q + d = [cos|d|, sin|d| d/|d|] q, a rotation of 2|d|.
+      r[i] = 2.0 * std::sqrt(std::max(0.0, res.covariance(base + i, base + i))) * 180.0 / M_PI;
+      t[i] = std::sqrt(std::max(0.0, res.covariance(base + 3 + i, base + 3 + i)));
+    }
+    res.rotation_stddev_deg.push_back(r);
+    res.translation_stddev_m.push_back(t);
+  }
+}
+
+}  // namespace
+
+std::vector<double> intrinsics_vector(const rig::CameraModel& m) {
+  std::vector<double> k = {m.fx, m.fy, m.cx, m.cy};
+  k.insert(k.end(), m.distortion_coeffs.begin(), m.distortion_coeffs.end());
+  return k;
+}
+
+CalibrationResult calibrate(const Target& target, const std::vector<CameraInput>& cams,
+                            const CalibrationOptions& opt) {
+  check_frames_pair_up(cams);
+  const Lens lens = lens_of(opt);
+  const int NK = lens.intrinsics_size();
+  const std::vector<Eigen::Vector3d> object = object_points(target);
+
+  // ---- initialization, per camera: OpenCV's calibration gives intrinsics and board poses ----
+  Parameters x;
+  std::vector<std::vector<std::optional<SE3>>> T_c_board(cams.size());
+  for (size_t c = 0; c < cams.size(); ++c)
+    x.intr.push_back(initial_intrinsics(cams[c], object, lens, opt.min_views, T_c_board[c]));
+  x.cam_pose = camera_poses(cams, T_c_board);
+  x.board = board_poses(T_c_board, x.cam_pose);
+
+  // ---- the joint problem, with outlier rejection ----
+  CalibrationResult res;
+  res.residuals = corner_residuals(cams, x.board);
+  reject_outliers(res.residuals, object, lens, opt, x);
+  // Final: plain least squares on the inliers, kept for the covariance.
+  ceres::Problem problem;
+  solve(res.residuals, object, lens, false, opt.huber_px, x, problem);
+  update_residuals(res.residuals, object, lens, x);
+  fit_statistics(res, cams.size(), NK, x.board);
+  add_covariance(res, problem, cams.size(), NK, x);
 
   for (size_t c = 0; c < cams.size(); ++c) {
-    CameraResult cr;
-    rig::CameraModel& m = cr.model;
-    m.fx = intr[c][0], m.fy = intr[c][1], m.cx = intr[c][2], m.cy = intr[c][3];
-    m.distortion_model = opt.model;
-    m.distortion_coeffs.assign(intr[c].begin() + 4, intr[c].end());
-    m.width = cams[c].width;
-    m.height = cams[c].height;
-    for (int i = 0; i < NK; ++i)
-      cr.stddev.push_back(std::sqrt(std::max(0.0, res.covariance(c * NK + i, c * NK + i))));
-    std::vector<double> sse_f(n_frames, 0.0);
-    std::vector<int> n_f(n_frames, 0);
-    for (const CornerResidual& r : res.residuals) {
-      if (r.camera != static_cast<int>(c) || r.outlier) continue;
-      sse_f[r.frame] += r.residual.squaredNorm();
-      ++n_f[r.frame];
-      ++cr.n_corners;
-    }
-    for (size_t f = 0; f < n_frames; ++f) {
-      cr.view_rms.push_back(n_f[f] ? std::sqrt(sse_f[f] / n_f[f]) : NAN);
-      cr.n_views += n_f[f] > 0;
-    }
-    res.cameras.push_back(cr);
-    res.T_cam_cam0.push_back(c == 0 ? SE3() : cam_pose[c].se3());
-    if (c == 0) {
-      res.rotation_stddev_deg.emplace_back(0, 0, 0);
-      res.translation_stddev_m.emplace_back(0, 0, 0);
-    } else {
-      const int base = static_cast<int>(cams.size()) * NK + 6 * (static_cast<int>(c) - 1);
-      Eigen::Vector3d r, t;
-      for (int i = 0; i < 3; ++i) {
-        // Ceres' quaternion tangent: q + d = [cos|d|, sin|d| d/|d|] q, a rotation of 2|d|.
-        r[i] = 2.0 * std::sqrt(std::max(0.0, res.covariance(base + i, base + i))) * 180.0 / M_PI;
-        t[i] = std::sqrt(std::max(0.0, res.covariance(base + 3 + i, base + 3 + i)));
-      }
-      res.rotation_stddev_deg.push_back(r);
-      res.translation_stddev_m.push_back(t);
-    }
+    res.cameras.push_back(camera_result(res, cams[c], c, NK, x.intr[c], opt.model));
+    add_camera_pose(res, c, cams.size(), NK, x.cam_pose);
   }
-  for (const auto& b : board)
+  for (const auto& b : x.board)
     res.T_cam0_board.push_back(b ? std::optional<SE3>(b->se3()) : std::nullopt);
   return res;
 }

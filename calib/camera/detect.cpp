@@ -7,6 +7,8 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "rigcal/core/stats.h"
+
 namespace rigcal::camera {
 namespace {
 
@@ -15,12 +17,6 @@ namespace {
 // real blurred JPEGs (0.4: 0.44 px RMS on the OpenCV stereo samples; 0.25: 0.21 px).
 int subpix_half_window(double feature_px) {
   return std::clamp(static_cast<int>(0.25 * feature_px), 2, 11);
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
 }
 
 // Mean intensity in a small disc, or -1 outside the image.
@@ -74,7 +70,7 @@ Detection detect_checkerboard(const cv::Mat& gray, const Target& t, const Detect
     for (int i = 0; i + 1 < t.cols; ++i)
       sq.push_back(cv::norm(corners[j * t.cols + i + 1] - corners[j * t.cols + i]));
   }
-  d.square_px = median(sq);
+  d.square_px = sq.empty() ? 0.0 : median(sq);  // empty: a target of one column
   const int w = subpix_half_window(d.square_px);
   cv::cornerSubPix(gray, corners, cv::Size(w, w), cv::Size(-1, -1),
                    cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-4));
@@ -157,7 +153,7 @@ Detection detect_aprilgrid(const cv::Mat& gray, const Target& t, const DetectOpt
   // neighbouring saddle; the solver's outlier rejection drops them), where 0.2 sent 21 % over
   // 1 px. aruco's own corners are ~2 px off on these grids (the tag's outline touches the corner
   // squares), so refinement is needed.
-  d.square_px = median(sizes);
+  d.square_px = sizes.empty() ? 0.0 : median(sizes);  // empty: no tag with min_tags <= 0
   const int w = std::clamp(static_cast<int>(0.12 * d.square_px), 2, 11);
   cv::cornerSubPix(gray, corners, cv::Size(w, w), cv::Size(-1, -1),
                    cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-4));

@@ -14,4 +14,16 @@ inline double median(std::vector<double> v) {
   return *mid;
 }
 
+// The median with the two middle values of an even count averaged (the textbook's, numpy's);
+// NaN when empty.
+inline double median_midpoint(std::vector<double> v) {
+  if (v.empty()) return NAN;
+  const size_t mid = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + mid, v.end());
+  if (v.size() % 2 == 1) return v[mid];
+  const double upper = v[mid];
+  const double lower = *std::max_element(v.begin(), v.begin() + mid);
+  return 0.5 * (lower + upper);
+}
+
 }  // namespace rigcal

@@ -1,6 +1,7 @@
 #pragma once
 // The one trajectory type of rigcal: poses of a tracked frame ("body") in a fixed frame
 // ("world"), each with its stamp. Readers and writers live in calib/io/trajectory_io.h.
+#include <optional>
 #include <vector>
 
 #include "rigcal/core/se3.h"
@@ -21,5 +22,13 @@ struct Trajectory {
 
 // Length of the path through the positions, m.
 double path_length(const Trajectory& trajectory);
+
+// The pose `fraction` of the way from T_a to T_b (0: T_a, 1: T_b): the rotation by slerp, the
+// translation linearly.
+SE3 interpolate(const SE3& T_a, const SE3& T_b, double fraction);
+
+// The pose at t: a pose stamped t as it is, else interpolated between the poses before and after
+// t when they are no more than max_gap apart; none outside the stamps or across a longer gap.
+std::optional<SE3> pose_at(const Trajectory& trajectory, Time t, Time max_gap);
 
 }  // namespace rigcal

@@ -1,9 +1,10 @@
 #include "rigcal/sim/trajectories.h"
 
+#include <algorithm>
 #include <cmath>
 
-#include "rigcal/bench/metrics.h"
 #include "rigcal/core/error.h"
+#include "rigcal/core/trajectory.h"
 
 namespace rigcal::sim {
 
@@ -24,7 +25,7 @@ std::pair<PoseSource, double> pose_source(const Trajectory& replay) {
     const size_t j = it - traj->stamps.begin();
     const double f = static_cast<double>((at - traj->stamps[j - 1]).ns) /
                      static_cast<double>((traj->stamps[j] - traj->stamps[j - 1]).ns);
-    return bench::interpolate(traj->T_world_body[j - 1], traj->T_world_body[j], f);
+    return interpolate(traj->T_world_body[j - 1], traj->T_world_body[j], f);
   };
   return {source, duration};
 }

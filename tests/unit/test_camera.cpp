@@ -15,6 +15,7 @@
 #include "rigcal/camera/lens.h"
 #include "rigcal/camera/uncertainty.h"
 #include "rigcal/core/error.h"
+#include "rigcal/core/stats.h"
 #include "rigcal/io/camera_report.h"
 #include "rigcal/io/target_pdf.h"
 #include "rigcal/io/target_yaml.h"
@@ -218,8 +219,7 @@ TruthZ check_against_truth(const SimCase& sc, uint64_t seed, bool print, bool st
   for (const auto& T : r.T_cam0_board) {
     if (T) distances.push_back(T->t.norm());
   }
-  std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
-  const double d = distances[distances.size() / 2];
+  const double d = median(distances);
   std::vector<double> zp;
   for (int c = 0; c < 2; ++c) {
     for (double x : projection_z(r, part, rig, c, d, print)) zp.push_back(x);
@@ -460,9 +460,9 @@ TEST(CameraDetect, AprilGridCornersMatchTruth) {
   ASSERT_FALSE(errors.empty());
   std::sort(errors.begin(), errors.end());
   std::printf("AprilGrid: %zu of %zu tags, median corner error %.3f px\n", tags,
-              part.left.size() * 36, errors[errors.size() / 2]);
+              part.left.size() * 36, median(errors));
   EXPECT_GE(tags, part.left.size() * 36 / 2);
-  EXPECT_LT(errors[errors.size() / 2], 0.1);
+  EXPECT_LT(median(errors), 0.1);
   EXPECT_LT(errors[errors.size() * 9 / 10], 0.3);
 }
 

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "fixtures.h"
+#include "rigcal/core/stats.h"
 #include "rigcal/io/trajectory_io.h"
 #include "rigcal/rig/rig_yaml.h"
 
@@ -462,10 +463,8 @@ TEST_F(Cli, HandEyeOpenCalibCarIsFlaggedNearPlanar) {
     rot.push_back(p["rotation_residual_deg"]);
     trans.push_back(p["translation_residual_m"]);
   }
-  std::sort(rot.begin(), rot.end());
-  std::sort(trans.begin(), trans.end());
   std::printf("OpenCalib: %zu pairs, median residual %.2g deg, %.4f m\n", rot.size(),
-              rot[rot.size() / 2], trans[trans.size() / 2]);
+              rigcal::median(rot), rigcal::median(trans));
 }
 
 // Motion-capture pairs (ETH's PrimeSense camera tracked against a target, and its Vicon body,

@@ -7,10 +7,10 @@
 #include <opencv2/imgproc.hpp>
 #include <set>
 
-#include "rigcal/bench/metrics.h"
 #include "rigcal/camera/detect.h"
 #include "rigcal/camera/lens.h"
 #include "rigcal/core/error.h"
+#include "rigcal/core/trajectory.h"
 #include "rigcal/io/target_yaml.h"
 #include "rigcal/rig/rig_yaml.h"
 #include "rigcal/sim/session.h"
@@ -324,10 +324,10 @@ TEST(SimTrajectories, OdometryDriftsSlowlyAndGnssHasOutagesAndFlaggedOutliers) {
     // The true GNSS pose from the truth trajectory at the LiDAR rate, interpolated.
     const size_t j = std::min<size_t>(static_cast<size_t>(t * 10), part.truth_base.size() - 2);
     const double f = t * 10 - j;
-    const SE3 T_truth = part.T_enu_world *
-                        bench::interpolate(part.truth_base.T_world_body[j],
-                                           part.truth_base.T_world_body[j + 1], f) *
-                        T_base_gnss;
+    const SE3 T_truth =
+        part.T_enu_world *
+        interpolate(part.truth_base.T_world_body[j], part.truth_base.T_world_body[j + 1], f) *
+        T_base_gnss;
     const double err = (T_truth.t - part.gnss.T_world_body[i].t).norm();
     if (outliers.count(i)) {
       EXPECT_GT(err, 0.3) << i;
