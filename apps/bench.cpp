@@ -7,8 +7,8 @@
 #include "cli.h"
 #include "rigcal/bench/evaluate.h"
 #include "rigcal/bench/leaderboard.h"
+#include "rigcal/bench/report.h"
 #include "rigcal/core/error.h"
-#include "rigcal/io/bench_report.h"
 #include "rigcal/io/files.h"
 #include "rigcal/io/trajectory_io.h"
 
@@ -111,7 +111,7 @@ void run_pair(const Options& o) {
   }
   for (const std::string& n : r.notes) fmt::print("note: {}\n", n);
   if (!o.report.empty()) {
-    io::write_bench_report(r, o.report, {{"gt", o.gt}, {"est", o.est}});
+    bench::write_bench_report(r, o.report, {{"gt", o.gt}, {"est", o.est}});
     fmt::print("report: {}/bench.json and plots\n", o.report);
   }
 }
@@ -122,12 +122,12 @@ void run_leaderboard(const Options& o) {
   in.ate_max = o.ate_max;
   in.rpe_max = o.rpe_max;
   const bench::EvalOptions options = eval_options(o);
-  in = io::load_leaderboard_input(o.gt_dir, o.est_dir, o.methods, read_options(o, "", ""), in);
+  in = bench::load_leaderboard_input(o.gt_dir, o.est_dir, o.methods, read_options(o, "", ""), in);
   const bench::Leaderboard board = bench::build_leaderboard(
       in, options, [](std::string_view msg) { fmt::print(stderr, "{}\n", msg); });
-  fmt::print("{}", io::leaderboard_markdown(board));
+  fmt::print("{}", bench::leaderboard_markdown(board));
   if (!o.report.empty()) {
-    io::write_leaderboard_report(board, o.report);
+    bench::write_leaderboard_report(board, o.report);
     fmt::print("report: {}/leaderboard.{{md,csv,json}} and cumulative curves\n", o.report);
   }
 }

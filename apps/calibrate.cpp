@@ -16,6 +16,7 @@ namespace {
 struct Options {
   session::CalibrateOptions run;
   std::string rig, target, odometry, gnss, out, bayer;
+  std::vector<std::string> fix, prior;  // hand-eye's
   bool no_estimate_offset = false;
 };
 
@@ -42,6 +43,9 @@ void run(Options o) {
   o.run.out = o.out;
   o.run.cameras.bayer = io::bayer_from_string(o.bayer);
   o.run.hand_eye.estimate_offset = !o.no_estimate_offset;
+  o.run.hand_eye.refine.fixed = hand_eye::parse_translation_constraints(o.fix, false);
+  for (const auto& p : hand_eye::parse_translation_constraints(o.prior, true))
+    o.run.hand_eye.refine.fixed.push_back(p);
   const session::CalibrateResult r = session::calibrate(o.run, console_progress());
   for (const session::StepRun& s : r.steps) {
     if (s.status == "not run") continue;
@@ -101,6 +105,11 @@ void add_calibrate(CLI::App& app) {
   cmd->add_option("--lidar-camera", o->run.lidar_camera.camera,
                   "the camera of the LiDAR-camera step")
       ->capture_default_str();
+  cmd->add_option("--fix", o->fix,
+                  "hand-eye: hold a translation component (GNSS/INS frame), e.g. z=0.35 (a car's "
+                  "vertical, which planar motion does not determine)");
+  cmd->add_option("--prior", o->prior,
+                  "hand-eye: a translation component's prior with its 1-sigma, e.g. z=0.35,0.02");
   cmd->add_flag("--no-estimate-offset", o->no_estimate_offset,
                 "hand-eye: keep the rig's GNSS/INS clock offset (a disagreement the "
                 "trajectories show is reported)");

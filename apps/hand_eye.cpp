@@ -25,38 +25,6 @@ struct Options {
   bool estimate_offset = false;
 };
 
-// --fix AXIS=METRES, or (with_sigma) --prior AXIS=METRES,SIGMA.
-std::vector<hand_eye::RefineOptions::Fixed> parse_fixes(const std::vector<std::string>& specs,
-                                                        bool with_sigma) {
-  std::vector<hand_eye::RefineOptions::Fixed> out;
-  const char* option = with_sigma ? "--prior" : "--fix";
-  for (const std::string& s : specs) {
-    const size_t eq = s.find('=');
-    const std::string axis = s.substr(0, eq);
-    Eigen::Vector3d d = Eigen::Vector3d::Zero();
-    if (axis == "x") d.x() = 1;
-    if (axis == "y") d.y() = 1;
-    if (axis == "z") d.z() = 1;
-    std::vector<double> v;
-    try {
-      if (eq == std::string::npos) throw Error("");
-      for (std::string_view f : split_fields(std::string_view(s).substr(eq + 1)))
-        v.push_back(parse_double(f, option));
-    } catch (const Error&) {
-      d.setZero();
-    }
-    if (d.isZero() || v.size() != (with_sigma ? 2u : 1u) || (with_sigma && !(v[1] > 0))) {
-      throw Error(with_sigma
-                      ? fmt::format("--prior '{}': expected x=METRES,SIGMA (SIGMA > 0), "
-                                    "y=... or z=...",
-                                    s)
-                      : fmt::format("--fix '{}': expected x=METRES, y=METRES or z=METRES", s));
-    }
-    out.push_back({d, v[0], with_sigma ? v[1] : 0.0});
-  }
-  return out;
-}
-
 void run(const Options& o) {
   if (!o.out.empty() && o.rig.empty())
     throw Error("--out writes the sensor's T_b into --rig: give it");
@@ -70,8 +38,9 @@ void run(const Options& o) {
   so.pairs.gnss_half_window_s = o.gnss_smoothing_s;
   so.refine.rotation_sigma_deg = o.rotation_sigma_deg;
   so.refine.translation_sigma_m = o.translation_sigma_m;
-  so.refine.fixed = parse_fixes(o.fix, false);
-  for (const hand_eye::RefineOptions::Fixed& p : parse_fixes(o.prior, true))
+  so.refine.fixed = hand_eye::parse_translation_constraints(o.fix, false);
+  for (const hand_eye::RefineOptions::Fixed& p :
+       hand_eye::parse_translation_constraints(o.prior, true))
     so.refine.fixed.push_back(p);
   so.max_sigma_m = o.max_sigma_m;
   so.estimate_offset = o.estimate_offset;

@@ -8,10 +8,10 @@
 #include <mutex>
 
 #include "rigcal/camera/calibrate.h"
+#include "rigcal/camera/report.h"
 #include "rigcal/camera/uncertainty.h"
 #include "rigcal/core/error.h"
 #include "rigcal/core/stats.h"
-#include "rigcal/io/camera_report.h"
 #include "rigcal/io/files.h"
 #include "rigcal/io/target_yaml.h"
 #include "rigcal/rig/rig_yaml.h"
@@ -48,7 +48,7 @@ Detections detect_all(const Target& target, const io::ImageSet& in, const StepOp
   const size_t n_cams = in.names.size(), n_frames = in.files[0].size();
   std::map<std::string, Detection> cache;
   if (!cache_path.empty() && std::filesystem::exists(cache_path))
-    cache = io::parse_corners_vnl(io::read_text_file(cache_path), target);
+    cache = parse_corners_vnl(io::read_text_file(cache_path), target);
   Detections d;
   for (size_t c = 0; c < n_cams; ++c) {
     for (size_t f = 0; f < n_frames; ++f) {
@@ -129,8 +129,7 @@ rig::Rig updated_rig(const StepInputs& in, const CalibrationResult& r) {
 }
 
 std::vector<std::string> summary_lines(const std::vector<std::string>& names,
-                                       const CalibrationResult& r,
-                                       const io::CameraReportInput& rep) {
+                                       const CalibrationResult& r, const CameraReportInput& rep) {
   std::vector<std::string> out;
   out.push_back(fmt::format(
       "RMS reprojection error: {:.4f} px per corner (2-D, OpenCV's), {:.4f} px per coordinate "
@@ -185,7 +184,7 @@ report::StepResult calibrate_cameras(const StepInputs& in, const StepOptions& o,
   out.wrote = names;
 
   // Report.
-  io::CameraReportInput rep;
+  CameraReportInput rep;
   rep.camera_names = names;
   rep.images = in.images.files;
   rep.inputs = {{"target", in.target.string()}, {"model", o.model}};
@@ -202,13 +201,13 @@ report::StepResult calibrate_cameras(const StepInputs& in, const StepOptions& o,
         r.cameras[c].model, r.covariance.block(c * nk, c * nk, nk, nk),
         rep.uncertainty_distance_m));
   }
-  out.report = io::cameras_json(r, rep);
+  out.report = cameras_json(r, rep);
   for (const std::string& n : in.images.notes) out.report["notes"].push_back(n);
   std::vector<std::string> all_images;
   std::vector<Detection> all_detections;
   for (const auto& [c, f] : d.jobs)
     all_images.push_back(in.images.files[c][f]), all_detections.push_back(d.cameras[c].frames[f]);
-  out.report_files.push_back({"corners.vnl", io::corners_vnl(target, all_images, all_detections)});
+  out.report_files.push_back({"corners.vnl", corners_vnl(target, all_images, all_detections)});
   out.report_files.push_back({"cameras.json", out.report.dump(2) + "\n"});
   report::finish_report(out, "cameras.json");
   for (size_t c = 0; c < n_cams; ++c) {
@@ -217,18 +216,18 @@ report::StepResult calibrate_cameras(const StepInputs& in, const StepOptions& o,
       if (d.cameras[c].frames[f].found) {
         out.report_files.push_back(
             {fmt::format("{}_corners.png", names[c]),
-             io::encode_png(io::corners_png(io::read_gray(in.images.files[c][f], o.bayer),
+             report::encode_png(corners_png(io::read_gray(in.images.files[c][f], o.bayer),
                                             d.cameras[c].frames[f]))});
         break;
       }
     }
     out.report_files.push_back(
         {fmt::format("{}_residuals.png", names[c]),
-         io::encode_png(io::residuals_png(r, static_cast<int>(c), w, h, 100.0))});
+         report::encode_png(residuals_png(r, static_cast<int>(c), w, h, 100.0))});
     out.report_files.push_back({fmt::format("{}_coverage.png", names[c]),
-                                io::encode_png(io::coverage_png(r, static_cast<int>(c), w, h))});
+                                report::encode_png(coverage_png(r, static_cast<int>(c), w, h))});
     out.report_files.push_back({fmt::format("{}_uncertainty.png", names[c]),
-                                io::encode_png(io::uncertainty_png(rep.uncertainty[c], w, h))});
+                                report::encode_png(uncertainty_png(rep.uncertainty[c], w, h))});
   }
 
   for (const std::string& line : summary_lines(names, r, rep)) out.summary.push_back(line);

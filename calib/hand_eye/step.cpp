@@ -8,8 +8,8 @@
 #include "rigcal/core/error.h"
 #include "rigcal/core/se3.h"
 #include "rigcal/core/text.h"
+#include "rigcal/hand_eye/report.h"
 #include "rigcal/io/gnss_fixes.h"
-#include "rigcal/io/hand_eye_report.h"
 
 namespace rigcal::hand_eye {
 namespace {
@@ -47,6 +47,37 @@ report::StepResult undetermined(report::StepResult out, std::string reason, std:
 }
 
 }  // namespace
+
+std::vector<RefineOptions::Fixed> parse_translation_constraints(
+    const std::vector<std::string>& specs, bool with_sigma) {
+  std::vector<RefineOptions::Fixed> out;
+  const char* option = with_sigma ? "--prior" : "--fix";
+  for (const std::string& s : specs) {
+    const size_t eq = s.find('=');
+    const std::string axis = s.substr(0, eq);
+    Eigen::Vector3d d = Eigen::Vector3d::Zero();
+    if (axis == "x") d.x() = 1;
+    if (axis == "y") d.y() = 1;
+    if (axis == "z") d.z() = 1;
+    std::vector<double> v;
+    try {
+      if (eq == std::string::npos) throw Error("");
+      for (std::string_view f : split_fields(std::string_view(s).substr(eq + 1)))
+        v.push_back(parse_double(f, option));
+    } catch (const Error&) {
+      d.setZero();
+    }
+    if (d.isZero() || v.size() != (with_sigma ? 2u : 1u) || (with_sigma && !(v[1] > 0))) {
+      throw Error(with_sigma
+                      ? fmt::format("--prior '{}': expected x=METRES,SIGMA (SIGMA > 0), "
+                                    "y=... or z=...",
+                                    s)
+                      : fmt::format("--fix '{}': expected x=METRES, y=METRES or z=METRES", s));
+    }
+    out.push_back({d, v[0], with_sigma ? v[1] : 0.0});
+  }
+  return out;
+}
 
 report::StepResult estimate_extrinsic(const StepInputs& in, const StepOptions& o,
                                       const report::Progress& progress) {
@@ -229,9 +260,9 @@ report::StepResult estimate_extrinsic(const StepInputs& in, const StepOptions& o
       fmt::format("odometry scale {:.5f} ± {:.5f} (GNSS/INS distance over LiDAR distance)",
                   r.odometry_scale, r.odometry_scale_sigma));
 
-  io::HandEyeInputs rin{in.lidar.string(), in.gnss.string(),    in.rig_source, offset_s, spacings,
-                        po.stride_s,       po.min_rotation_deg, o.max_sigma_m, notes};
-  out.report_files = io::hand_eye_report_files("", rin, pairs, cf, r, lidar, gnss);
+  HandEyeInputs rin{in.lidar.string(), in.gnss.string(),    in.rig_source, offset_s, spacings,
+                    po.stride_s,       po.min_rotation_deg, o.max_sigma_m, notes};
+  out.report_files = hand_eye_report_files("", rin, pairs, cf, r, lidar, gnss);
   report::finish_report(out, "hand_eye.json");
 
   if (in.rig) {

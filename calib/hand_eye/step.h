@@ -32,6 +32,12 @@ struct StepInputs {
   std::string rig_source;       // where the rig came from, for the report
 };
 
+// Translation components held (`--fix AXIS=METRES`) or given a prior (`with_sigma`: `--prior
+// AXIS=METRES,SIGMA`), AXIS x, y or z of the GNSS/INS frame. Throws rigcal::Error naming the
+// option and what it expects.
+std::vector<RefineOptions::Fixed> parse_translation_constraints(
+    const std::vector<std::string>& specs, bool with_sigma);
+
 // Status undetermined when the clock offset cannot be estimated (with estimate_offset) or a
 // translation direction is determined neither by the motion nor by a fix, a prior or the rig.
 // Throws rigcal::Error on bad input: unreadable trajectories, no overlap in time, too few motion

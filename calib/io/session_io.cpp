@@ -9,8 +9,9 @@
 #include "rigcal/core/error.h"
 #include "rigcal/core/text.h"
 #include "rigcal/io/files.h"
-#include "rigcal/io/png.h"
 #include "rigcal/io/trajectory_io.h"
+#include "rigcal/report/json.h"
+#include "rigcal/report/png.h"
 
 namespace rigcal::io {
 namespace fs = std::filesystem;
@@ -30,20 +31,13 @@ std::string corners_csv(const std::vector<std::vector<Eigen::Vector2d>>& corners
   return out;
 }
 
-nlohmann::json pose_json(const SE3& T) {
-  const Eigen::Matrix4d m = T.matrix();
-  nlohmann::json rows = nlohmann::json::array();
-  for (int r = 0; r < 4; ++r) rows.push_back({m(r, 0), m(r, 1), m(r, 2), m(r, 3)});
-  return rows;
-}
-
 void write_camera(const fs::path& dir, const std::vector<Time>& stamps,
                   const std::vector<cv::Mat>& images,
                   const std::vector<std::vector<Eigen::Vector2d>>& corners) {
   std::vector<OutputFile> files{{dir / "timestamps.txt", timestamps_txt(stamps)},
                                 {dir / "corners_truth.csv", corners_csv(corners)}};
   for (size_t k = 0; k < images.size(); ++k)
-    files.push_back({dir / "data" / frame_name(k, "png"), encode_png(images[k])});
+    files.push_back({dir / "data" / frame_name(k, "png"), report::encode_png(images[k])});
   write_files_atomic(files);
 }
 
@@ -131,7 +125,7 @@ void write_stereo(const fs::path& dir, const sim::StereoPart& part, nlohmann::js
   nlohmann::json& j = truth["stereo"];
   j["cameras"] = {part.left_name, part.right_name};
   j["T_left_board"] = nlohmann::json::array();
-  for (const SE3& T : part.T_left_board) j["T_left_board"].push_back(pose_json(T));
+  for (const SE3& T : part.T_left_board) j["T_left_board"].push_back(report::pose_json(T));
 }
 
 void write_lidar_camera(const fs::path& dir, const sim::LidarCameraPart& part,
@@ -144,7 +138,7 @@ void write_lidar_camera(const fs::path& dir, const sim::LidarCameraPart& part,
   j["T_lidar_board"] = nlohmann::json::array();
   j["board_points"] = nlohmann::json::array();
   for (size_t k = 0; k < part.T_lidar_board.size(); ++k) {
-    j["T_lidar_board"].push_back(pose_json(part.T_lidar_board[k]));
+    j["T_lidar_board"].push_back(report::pose_json(part.T_lidar_board[k]));
     size_t on_board = 0;
     for (const sim::LidarPoint& p : part.scans[k]) on_board += p.object == 1;
     j["board_points"].push_back(on_board);
@@ -179,7 +173,7 @@ void write_trajectories(const fs::path& dir, const sim::TrajectoryPart& part,
        {dir / "trajectories" / "gnss_ins.tum", trajectory_to_tum(part.gnss)}});
   nlohmann::json& j = truth["trajectories"];
   j["gnss_sensor"] = part.gnss_name;
-  j["T_enu_world"] = pose_json(part.T_enu_world);
+  j["T_enu_world"] = report::pose_json(part.T_enu_world);
   j["gnss_outlier_indices"] = part.gnss_outliers;
   j["files"] = {{"truth_lidar.tum", "T_world_lidar, the truth, LiDAR rate"},
                 {"lidar_odometry.tum", "T_odom_lidar, drifting odometry"},

@@ -6,9 +6,9 @@
 #include "rigcal/core/error.h"
 #include "rigcal/io/image_io.h"
 #include "rigcal/io/image_sets.h"
-#include "rigcal/io/lidar_camera_report.h"
 #include "rigcal/io/point_cloud_io.h"
 #include "rigcal/io/target_yaml.h"
+#include "rigcal/lidar_camera/report.h"
 
 namespace rigcal::lidar_camera {
 namespace fs = std::filesystem;
@@ -123,14 +123,14 @@ report::StepResult calibrate_lidar_camera(const StepInputs& in, const StepOption
       s.observability.singular_values[2], s.observability.condition, s.noise_scale));
   out.notes = in.notes;
 
-  io::LidarCameraInputs rin{in.images,
-                            in.scans,
-                            in.target.string(),
-                            in.rig_source,
-                            o.camera,
-                            search.board_width_m,
-                            search.board_height_m};
-  out.report_files = io::lidar_camera_report_files("", rin, pairs, c, cam, shown);
+  LidarCameraInputs rin{in.images,
+                        in.scans,
+                        in.target.string(),
+                        in.rig_source,
+                        o.camera,
+                        search.board_width_m,
+                        search.board_height_m};
+  out.report_files = lidar_camera_report_files("", rin, pairs, c, cam, shown);
   report::finish_report(out, "lidar_camera.json");
 
   // The camera placed from the LiDAR: T_b(camera) = T_b(lidar) T_camera_lidar^-1; every other

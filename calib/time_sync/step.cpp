@@ -7,7 +7,7 @@
 #include "rigcal/core/error.h"
 #include "rigcal/core/se3.h"
 #include "rigcal/core/text.h"
-#include "rigcal/io/time_sync_report.h"
+#include "rigcal/time_sync/report.h"
 
 namespace rigcal::time_sync {
 namespace fs = std::filesystem;
@@ -28,7 +28,7 @@ report::StepResult estimate_clock(const StepInputs& in, const TimeSyncOptions& t
                                   const report::Progress& progress) {
   report::StepResult out;
   out.step = "time_sync";
-  io::TimeSyncInputs rin;
+  TimeSyncInputs rin;
   rin.reference = in.reference.path.string(), rin.other = in.other.path.string();
   rin.sensor = in.other.sensor, rin.reference_sensor = in.reference.sensor;
   if (in.rig) {
@@ -69,7 +69,7 @@ report::StepResult estimate_clock(const StepInputs& in, const TimeSyncOptions& t
                   oth.format, (oth.rates.stamps.back() - oth.rates.stamps.front()).seconds()));
 
   const TimeSyncResult r = estimate_time_offset(ref.rates, oth.rates, topt);
-  out.report_files = io::time_sync_report_files("", r, topt, rin, ref.rates, oth.rates);
+  out.report_files = time_sync_report_files("", r, topt, rin, ref.rates, oth.rates);
   out.notes = rin.notes;
   out.inputs = {{"reference", in.reference.path}, {"other", in.other.path}};
   out.rig = in.rig.value_or(rig::Rig{});

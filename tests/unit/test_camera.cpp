@@ -13,10 +13,10 @@
 #include "fixtures.h"
 #include "rigcal/camera/calibrate.h"
 #include "rigcal/camera/lens.h"
+#include "rigcal/camera/report.h"
 #include "rigcal/camera/uncertainty.h"
 #include "rigcal/core/error.h"
 #include "rigcal/core/stats.h"
-#include "rigcal/io/camera_report.h"
 #include "rigcal/io/target_pdf.h"
 #include "rigcal/io/target_yaml.h"
 #include "rigcal/rig/rig_yaml.h"
@@ -378,7 +378,7 @@ TEST(CameraPeers, MrcalOnTheSameCorners) {
   const std::filesystem::path work =
       std::filesystem::temp_directory_path() / ("rigcal_mrcal_" + std::to_string(::getpid()));
   std::filesystem::create_directories(work);
-  std::ofstream((work / "corners.vnl").string()) << io::corners_vnl(target, names, detections);
+  std::ofstream((work / "corners.vnl").string()) << camera::corners_vnl(target, names, detections);
   const std::string cmd = fmt::format(
       "cd {} && mrcal-calibrate-cameras --corners-cache corners.vnl --lensmodel LENSMODEL_OPENCV4 "
       "--focal 535 "

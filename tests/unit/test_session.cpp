@@ -360,7 +360,7 @@ TEST(Sha256, KnownVectorsAndFiles) {
             "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
   const fs::path file = fs::temp_directory_path() / fmt::format("rigcal_sha_{}", ::getpid());
   std::string bytes;
-  for (int i = 0; i < 3'000'000; ++i) bytes += static_cast<char>(i * 7919 % 251);
+  for (uint64_t i = 0; i < 3'000'000; ++i) bytes += static_cast<char>(i * 7919 % 251);
   io::write_file_atomic(file, bytes);
   EXPECT_EQ(sha256_file(file), sha256_hex(bytes));
   fs::remove(file);

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-namespace rigcal::io {
+namespace rigcal::report {
 
 struct PlotSeries {
   std::string label;
@@ -24,4 +24,4 @@ std::string render_svg(const Plot& plot);
 // The same plot as PNG bytes (lines and points; no colour bar), for reports that ask for PNG.
 std::string render_png(const Plot& plot);
 
-}  // namespace rigcal::io
+}  // namespace rigcal::report

@@ -12,7 +12,7 @@
 #include "rigcal/lidar_camera/solve.h"
 #include "rigcal/rig/rig.h"
 
-namespace rigcal::io {
+namespace rigcal::lidar_camera {
 
 struct LidarCameraInputs {
   std::vector<std::string> images, scans;  // per pair, as given
@@ -20,12 +20,12 @@ struct LidarCameraInputs {
   double board_width_m = 0, board_height_m = 0;
 };
 
-std::vector<OutputFile> lidar_camera_report_files(const std::filesystem::path& dir,
-                                                  const LidarCameraInputs& in,
-                                                  const std::vector<lidar_camera::PairInput>& pairs,
-                                                  const lidar_camera::Calibration& c,
-                                                  const rig::CameraModel& camera,
-                                                  const std::vector<cv::Mat>& images);
+std::vector<io::OutputFile> lidar_camera_report_files(const std::filesystem::path& dir,
+                                                      const LidarCameraInputs& in,
+                                                      const std::vector<PairInput>& pairs,
+                                                      const Calibration& c,
+                                                      const rig::CameraModel& camera,
+                                                      const std::vector<cv::Mat>& images);
 
 // The quick-look image of one pair (BGR): `image` with `scan` projected (points within 0.2-30 m,
 // coloured by depth, near red to far blue), the LiDAR board points in white.
@@ -33,4 +33,4 @@ cv::Mat overlay(const cv::Mat& image, const std::vector<Eigen::Vector3d>& scan,
                 const std::vector<Eigen::Vector3d>& board_points, const SE3& T_camera_lidar,
                 const rig::CameraModel& camera);
 
-}  // namespace rigcal::io
+}  // namespace rigcal::lidar_camera

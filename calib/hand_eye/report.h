@@ -10,7 +10,7 @@
 #include "rigcal/hand_eye/hand_eye.h"
 #include "rigcal/io/files.h"
 
-namespace rigcal::io {
+namespace rigcal::hand_eye {
 
 struct HandEyeInputs {
   std::string lidar, gnss, rig;  // paths as given
@@ -20,11 +20,10 @@ struct HandEyeInputs {
   std::vector<std::string> notes;
 };
 
-std::vector<OutputFile> hand_eye_report_files(const std::filesystem::path& dir,
-                                              const HandEyeInputs& in,
-                                              const std::vector<hand_eye::MotionPair>& pairs,
-                                              const hand_eye::ClosedForm& cf,
-                                              const hand_eye::Refined& r, const Trajectory& lidar,
-                                              const Trajectory& gnss);
+std::vector<io::OutputFile> hand_eye_report_files(const std::filesystem::path& dir,
+                                                  const HandEyeInputs& in,
+                                                  const std::vector<MotionPair>& pairs,
+                                                  const ClosedForm& cf, const Refined& r,
+                                                  const Trajectory& lidar, const Trajectory& gnss);
 
-}  // namespace rigcal::io
+}  // namespace rigcal::hand_eye

@@ -9,7 +9,7 @@
 #include "rigcal/io/files.h"
 #include "rigcal/time_sync/time_sync.h"
 
-namespace rigcal::io {
+namespace rigcal::time_sync {
 
 struct TimeSyncInputs {
   std::string reference, other;                // paths as given
@@ -19,16 +19,12 @@ struct TimeSyncInputs {
   std::vector<std::string> notes;              // what the readers assumed or did
 };
 
-nlohmann::json time_sync_json(const time_sync::TimeSyncResult& result,
-                              const time_sync::TimeSyncOptions& options,
+nlohmann::json time_sync_json(const TimeSyncResult& result, const TimeSyncOptions& options,
                               const TimeSyncInputs& inputs);
 
 // time_sync.json, correlation.png, aligned.png and (when windows were estimated) windows.png.
-std::vector<OutputFile> time_sync_report_files(const std::filesystem::path& dir,
-                                               const time_sync::TimeSyncResult& result,
-                                               const time_sync::TimeSyncOptions& options,
-                                               const TimeSyncInputs& inputs,
-                                               const time_sync::AngularRates& reference,
-                                               const time_sync::AngularRates& other);
+std::vector<io::OutputFile> time_sync_report_files(
+    const std::filesystem::path& dir, const TimeSyncResult& result, const TimeSyncOptions& options,
+    const TimeSyncInputs& inputs, const AngularRates& reference, const AngularRates& other);
 
-}  // namespace rigcal::io
+}  // namespace rigcal::time_sync

@@ -1,4 +1,4 @@
-#include "rigcal/io/time_sync_report.h"
+#include "rigcal/time_sync/report.h"
 
 #include <fmt/format.h>
 
@@ -6,20 +6,12 @@
 
 #include "rigcal/core/se3.h"
 #include "rigcal/core/version.h"
-#include "rigcal/io/svg_plot.h"
+#include "rigcal/report/json.h"
+#include "rigcal/report/svg_plot.h"
 
-namespace rigcal::io {
-namespace {
+namespace rigcal::time_sync {
 
-using time_sync::AngularRates;
-using time_sync::TimeSyncResult;
-
-// NaN becomes null in JSON; keep it explicit.
-nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
-
-}  // namespace
-
-nlohmann::json time_sync_json(const TimeSyncResult& r, const time_sync::TimeSyncOptions& o,
+nlohmann::json time_sync_json(const TimeSyncResult& r, const TimeSyncOptions& o,
                               const TimeSyncInputs& in) {
   nlohmann::json j;
   j["tool_version"] = version_string();
@@ -36,24 +28,24 @@ nlohmann::json time_sync_json(const TimeSyncResult& r, const time_sync::TimeSync
                  {"notes", in.notes}};
   j["verdict"] = r.verdict;
   j["reason"] = r.reason;
-  j["offset_s"] = number(r.offset_s);
-  j["sigma_s"] = number(r.sigma_s);
+  j["offset_s"] = report::finite_or_null(r.offset_s);
+  j["sigma_s"] = report::finite_or_null(r.sigma_s);
   j["epoch_other_s"] = to_seconds_text(r.epoch);
   if (!in.sensor.empty() && r.verdict == "ok") {
     j["sensor_time_offset_s"] = in.reference_time_offset_s + r.offset_s;
   }
-  j["sigma_detail"] = {{"formal_s", number(r.sigma_formal_s)},
-                       {"windows_s", number(r.sigma_windows_s)},
+  j["sigma_detail"] = {{"formal_s", report::finite_or_null(r.sigma_formal_s)},
+                       {"windows_s", report::finite_or_null(r.sigma_windows_s)},
                        {"explanation",
                         "formal: from the residuals at the optimum and their slope in the offset, "
                         "inflated for residuals correlated in time; windows: spread of the "
                         "windowed offsets; sigma_s is the larger (or the drift fit's when drift "
                         "is significant)"}};
   j["stages_s"] = {{"coarse_fft", r.coarse_offset_s},
-                   {"integer_fine", number(r.integer_offset_s)},
-                   {"parabolic", number(r.parabolic_offset_s)},
-                   {"norm_continuous", number(r.norm_offset_s)},
-                   {"final", number(r.offset_s)}};
+                   {"integer_fine", report::finite_or_null(r.integer_offset_s)},
+                   {"parabolic", report::finite_or_null(r.parabolic_offset_s)},
+                   {"norm_continuous", report::finite_or_null(r.norm_offset_s)},
+                   {"final", report::finite_or_null(r.offset_s)}};
   j["peak"] = {{"ncc", r.peak_ncc},
                {"second_peak_ncc", r.second_peak_ncc},
                {"second_peak_offset_s", r.second_peak_offset_s},
@@ -86,45 +78,47 @@ nlohmann::json time_sync_json(const TimeSyncResult& r, const time_sync::TimeSync
                        {"residual_rms_rad_s", r.residual_rms_rad_s},
                        {"samples", r.samples_used}};
     nlohmann::json windows = nlohmann::json::array();
-    for (const time_sync::WindowOffset& w : r.windows) {
+    for (const WindowOffset& w : r.windows) {
       windows.push_back({{"t_other_s", w.t_other_s},
-                         {"offset_s", number(w.offset_s)},
-                         {"sigma_s", number(w.sigma_s)},
-                         {"ncc", number(w.ncc)},
+                         {"offset_s", report::finite_or_null(w.offset_s)},
+                         {"sigma_s", report::finite_or_null(w.sigma_s)},
+                         {"ncc", report::finite_or_null(w.ncc)},
                          {"used", w.used},
                          {"note", w.note}});
     }
-    j["drift"] = {{"estimated", r.drift_estimated},
-                  {"significant", r.drift_significant},
-                  {"significance_sigmas", number(r.drift_significance_sigma)},
-                  {"drift_ppm", r.drift_estimated ? number(r.drift_ppm) : nlohmann::json()},
-                  {"sigma_ppm", r.drift_estimated ? number(r.drift_sigma_ppm) : nlohmann::json()},
-                  {"rule", "significant when |drift| > 3 sigma (at least 4 usable windows)"},
-                  {"window_s", r.window_s},
-                  {"window_residual_rms_s", number(r.window_residual_rms_s)},
-                  {"mean_offset_s", number(r.mean_offset_s)},
-                  {"windows", windows}};
+    j["drift"] = {
+        {"estimated", r.drift_estimated},
+        {"significant", r.drift_significant},
+        {"significance_sigmas", report::finite_or_null(r.drift_significance_sigma)},
+        {"drift_ppm", r.drift_estimated ? report::finite_or_null(r.drift_ppm) : nlohmann::json()},
+        {"sigma_ppm",
+         r.drift_estimated ? report::finite_or_null(r.drift_sigma_ppm) : nlohmann::json()},
+        {"rule", "significant when |drift| > 3 sigma (at least 4 usable windows)"},
+        {"window_s", r.window_s},
+        {"window_residual_rms_s", report::finite_or_null(r.window_residual_rms_s)},
+        {"mean_offset_s", report::finite_or_null(r.mean_offset_s)},
+        {"windows", windows}};
   }
   return j;
 }
 
-std::vector<OutputFile> time_sync_report_files(
-    const std::filesystem::path& dir, const TimeSyncResult& r, const time_sync::TimeSyncOptions& o,
+std::vector<io::OutputFile> time_sync_report_files(
+    const std::filesystem::path& dir, const TimeSyncResult& r, const TimeSyncOptions& o,
     const TimeSyncInputs& in, const AngularRates& reference, const AngularRates& other) {
-  std::vector<OutputFile> files;
+  std::vector<io::OutputFile> files;
   files.push_back({dir / "time_sync.json", time_sync_json(r, o, in).dump(2) + "\n"});
   {
-    Plot p;
+    report::Plot p;
     p.title = "Normalized correlation of |w| against the offset";
     p.x_label = "offset (s): t_reference = t_other + offset";
     p.y_label = "NCC";
-    PlotSeries coarse{"coarse (FFT)", {}, {}, {}}, fine{"fine grid", {}, {}, {}};
+    report::PlotSeries coarse{"coarse (FFT)", {}, {}, {}}, fine{"fine grid", {}, {}, {}};
     for (const auto& c : r.coarse_curve) coarse.x.push_back(c.offset_s), coarse.y.push_back(c.ncc);
     for (const auto& c : r.fine_curve) fine.x.push_back(c.offset_s), fine.y.push_back(c.ncc);
     // Around the peak: +-10 x the fine range, or everything when the search was small.
     if (!fine.x.empty()) {
       const double half = 10 * (fine.x.back() - fine.x.front());
-      PlotSeries near{"coarse (FFT)", {}, {}, {}};
+      report::PlotSeries near{"coarse (FFT)", {}, {}, {}};
       for (size_t i = 0; i < coarse.x.size(); ++i) {
         if (std::abs(coarse.x[i] - r.coarse_offset_s) <= half)
           near.x.push_back(coarse.x[i]), near.y.push_back(coarse.y[i]);
@@ -132,7 +126,7 @@ std::vector<OutputFile> time_sync_report_files(
       coarse = near;
     }
     p.series = {coarse, fine};
-    files.push_back({dir / "correlation.png", render_png(p)});
+    files.push_back({dir / "correlation.png", report::render_png(p)});
   }
   if (r.verdict == "ok") {
     // 20 s in the middle of the overlap, on the reference clock.
@@ -146,11 +140,11 @@ std::vector<OutputFile> time_sync_report_files(
     const double b = std::min((reference.stamps.back() - reference.stamps.front()).seconds(),
                               ref_time(other.stamps.back()));
     const double mid = 0.5 * (a + b), lo = std::max(a, mid - 10), hi = std::min(b, mid + 10);
-    Plot p;
+    report::Plot p;
     p.title = "|w| after alignment (20 s in the middle of the overlap)";
     p.x_label = fmt::format("reference time (s since {:.3f})", t_ref0);
     p.y_label = "|w| (rad/s)";
-    PlotSeries sr{"reference", {}, {}, {}}, so{"other, shifted", {}, {}, {}};
+    report::PlotSeries sr{"reference", {}, {}, {}}, so{"other, shifted", {}, {}, {}};
     for (size_t i = 0; i < reference.stamps.size(); ++i) {
       const double t = (reference.stamps[i] - reference.stamps.front()).seconds();
       if (t >= lo && t <= hi) sr.x.push_back(t), sr.y.push_back(reference.rates[i].norm());
@@ -160,9 +154,9 @@ std::vector<OutputFile> time_sync_report_files(
       if (t >= lo && t <= hi) so.x.push_back(t), so.y.push_back(other.rates[i].norm());
     }
     p.series = {sr, so};
-    files.push_back({dir / "aligned.png", render_png(p)});
+    files.push_back({dir / "aligned.png", report::render_png(p)});
     if (!r.windows.empty()) {
-      Plot w;
+      report::Plot w;
       w.title = r.drift_estimated
                     ? fmt::format("Windowed offsets; drift {:.2f} +- {:.2f} ppm ({})", r.drift_ppm,
                                   r.drift_sigma_ppm,
@@ -170,9 +164,9 @@ std::vector<OutputFile> time_sync_report_files(
                     : "Windowed offsets (too few for a drift fit)";
       w.x_label = "other clock (s since the epoch)";
       w.y_label = "offset - final offset (ms)";
-      PlotSeries used{"used", {}, {}, {}}, fit{"drift fit", {}, {}, {}},
+      report::PlotSeries used{"used", {}, {}, {}}, fit{"drift fit", {}, {}, {}},
           rejected{"outliers", {}, {}, {}};
-      for (const time_sync::WindowOffset& x : r.windows) {
+      for (const WindowOffset& x : r.windows) {
         if (!x.used) {
           if (std::isfinite(x.offset_s)) {
             rejected.x.push_back(x.t_other_s);
@@ -192,10 +186,10 @@ std::vector<OutputFile> time_sync_report_files(
       w.series = {used};
       if (!fit.x.empty()) w.series.push_back(fit);
       if (!rejected.x.empty()) w.series.push_back(rejected);
-      files.push_back({dir / "windows.png", render_png(w)});
+      files.push_back({dir / "windows.png", report::render_png(w)});
     }
   }
   return files;
 }
 
-}  // namespace rigcal::io
+}  // namespace rigcal::time_sync

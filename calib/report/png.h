@@ -3,9 +3,9 @@
 #include <opencv2/core.hpp>
 #include <string>
 
-namespace rigcal::io {
+namespace rigcal::report {
 
 // Throws rigcal::Error when OpenCV cannot encode the image.
 std::string encode_png(const cv::Mat& image);
 
-}  // namespace rigcal::io
+}  // namespace rigcal::report

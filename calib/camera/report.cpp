@@ -1,4 +1,4 @@
-#include "rigcal/io/camera_report.h"
+#include "rigcal/camera/report.h"
 
 #include <fmt/format.h>
 
@@ -10,13 +10,13 @@
 #include "rigcal/core/text.h"
 #include "rigcal/core/version.h"
 
-namespace rigcal::io {
+namespace rigcal::camera {
 namespace {
 
-std::string target_header(const camera::Target& t) {
+std::string target_header(const Target& t) {
   return fmt::format("# rigcal corners of target {} ({} {} x {})", t.name,
-                     t.type == camera::TargetType::checkerboard ? "checkerboard" : "aprilgrid",
-                     t.cols, t.rows);
+                     t.type == TargetType::checkerboard ? "checkerboard" : "aprilgrid", t.cols,
+                     t.rows);
 }
 
 cv::Mat colour(const cv::Mat& values_0_1) {
@@ -28,12 +28,12 @@ cv::Mat colour(const cv::Mat& values_0_1) {
 
 }  // namespace
 
-std::string corners_vnl(const camera::Target& target, const std::vector<std::string>& images,
-                        const std::vector<camera::Detection>& detections) {
-  const size_t n = camera::object_points(target).size();
+std::string corners_vnl(const Target& target, const std::vector<std::string>& images,
+                        const std::vector<Detection>& detections) {
+  const size_t n = object_points(target).size();
   std::string out = target_header(target) + "\n# filename x y level\n";
   for (size_t i = 0; i < images.size(); ++i) {
-    const camera::Detection& d = detections[i];
+    const Detection& d = detections[i];
     if (!d.found) {
       out += images[i] + " - - -\n";
       continue;
@@ -49,11 +49,10 @@ std::string corners_vnl(const camera::Target& target, const std::vector<std::str
   return out;
 }
 
-std::map<std::string, camera::Detection> parse_corners_vnl(std::string_view text,
-                                                           const camera::Target& target) {
-  std::map<std::string, camera::Detection> out;
+std::map<std::string, Detection> parse_corners_vnl(std::string_view text, const Target& target) {
+  std::map<std::string, Detection> out;
   if (text.substr(0, text.find('\n')) != target_header(target)) return out;
-  const size_t n = camera::object_points(target).size();
+  const size_t n = object_points(target).size();
   std::map<std::string, std::vector<std::string_view>> lines;
   std::vector<std::string> order;
   size_t pos = 0;
@@ -70,7 +69,7 @@ std::map<std::string, camera::Detection> parse_corners_vnl(std::string_view text
     lines[name].push_back(line);
   }
   for (const std::string& name : order) {
-    camera::Detection d;
+    Detection d;
     const auto& ls = lines[name];
     if (ls.size() == n) {
       for (size_t p = 0; p < n; ++p) {
@@ -86,7 +85,7 @@ std::map<std::string, camera::Detection> parse_corners_vnl(std::string_view text
   return out;
 }
 
-nlohmann::json cameras_json(const camera::CalibrationResult& r, const CameraReportInput& in) {
+nlohmann::json cameras_json(const CalibrationResult& r, const CameraReportInput& in) {
   nlohmann::json j;
   j["tool_version"] = version_string();
   j["inputs"] = in.inputs;
@@ -111,7 +110,7 @@ nlohmann::json cameras_json(const camera::CalibrationResult& r, const CameraRepo
        "the frames; intrinsics_only_*: a point fixed in the camera frame through perturbed "
        "intrinsics (no board poses), for comparison"}};
   for (size_t c = 0; c < r.cameras.size(); ++c) {
-    const camera::CameraResult& cr = r.cameras[c];
+    const CameraResult& cr = r.cameras[c];
     nlohmann::json cj;
     cj["name"] = in.camera_names[c];
     cj["model"] = {{"camera_model", "pinhole"},
@@ -131,13 +130,13 @@ nlohmann::json cameras_json(const camera::CalibrationResult& r, const CameraRepo
     }
     cj["views"] = views;
     if (c < in.uncertainty.size()) {
-      const camera::UncertaintyMap& u = in.uncertainty[c];
+      const UncertaintyMap& u = in.uncertainty[c];
       cj["projection_uncertainty"] = {{"distance_m", in.uncertainty_distance_m},
                                       {"mean_px", u.mean_px},
                                       {"max_px", u.max_px},
                                       {"centre_px", u.centre_px}};
       if (c < in.uncertainty_intrinsics_only.size()) {
-        const camera::UncertaintyMap& ui = in.uncertainty_intrinsics_only[c];
+        const UncertaintyMap& ui = in.uncertainty_intrinsics_only[c];
         cj["projection_uncertainty"]["intrinsics_only_mean_px"] = ui.mean_px;
         cj["projection_uncertainty"]["intrinsics_only_max_px"] = ui.max_px;
         cj["projection_uncertainty"]["intrinsics_only_centre_px"] = ui.centre_px;
@@ -160,11 +159,11 @@ nlohmann::json cameras_json(const camera::CalibrationResult& r, const CameraRepo
     j["cameras"].push_back(cj);
   }
   // The worst inlier corners and every outlier.
-  std::vector<const camera::CornerResidual*> sorted;
-  for (const camera::CornerResidual& cr : r.residuals) sorted.push_back(&cr);
+  std::vector<const CornerResidual*> sorted;
+  for (const CornerResidual& cr : r.residuals) sorted.push_back(&cr);
   std::sort(sorted.begin(), sorted.end(),
             [](auto* a, auto* b) { return a->residual.norm() > b->residual.norm(); });
-  auto corner = [&](const camera::CornerResidual& cr) {
+  auto corner = [&](const CornerResidual& cr) {
     return nlohmann::json{{"camera", in.camera_names[cr.camera]},
                           {"image", in.images[cr.camera][cr.frame]},
                           {"point", cr.point},
@@ -183,7 +182,7 @@ nlohmann::json cameras_json(const camera::CalibrationResult& r, const CameraRepo
   return j;
 }
 
-cv::Mat corners_png(const cv::Mat& gray, const camera::Detection& d) {
+cv::Mat corners_png(const cv::Mat& gray, const Detection& d) {
   cv::Mat out;
   cv::cvtColor(gray, out, cv::COLOR_GRAY2BGR);
   for (size_t i = 0; i < d.pixels.size(); ++i) {
@@ -199,10 +198,10 @@ cv::Mat corners_png(const cv::Mat& gray, const camera::Detection& d) {
   return out;
 }
 
-cv::Mat residuals_png(const camera::CalibrationResult& r, int camera, int width, int height,
+cv::Mat residuals_png(const CalibrationResult& r, int camera, int width, int height,
                       double magnify) {
   cv::Mat out(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
-  for (const camera::CornerResidual& cr : r.residuals) {
+  for (const CornerResidual& cr : r.residuals) {
     if (cr.camera != camera) continue;
     const cv::Point a(static_cast<int>(cr.observed.x()), static_cast<int>(cr.observed.y()));
     const Eigen::Vector2d e = cr.observed + magnify * cr.residual;
@@ -215,10 +214,10 @@ cv::Mat residuals_png(const camera::CalibrationResult& r, int camera, int width,
   return out;
 }
 
-cv::Mat coverage_png(const camera::CalibrationResult& r, int camera, int width, int height) {
+cv::Mat coverage_png(const CalibrationResult& r, int camera, int width, int height) {
   const int cell = 20;
   cv::Mat counts = cv::Mat::zeros((height + cell - 1) / cell, (width + cell - 1) / cell, CV_64F);
-  for (const camera::CornerResidual& cr : r.residuals) {
+  for (const CornerResidual& cr : r.residuals) {
     if (cr.camera != camera || cr.outlier) continue;
     const int u = std::clamp(static_cast<int>(cr.observed.x()) / cell, 0, counts.cols - 1);
     const int v = std::clamp(static_cast<int>(cr.observed.y()) / cell, 0, counts.rows - 1);
@@ -235,7 +234,7 @@ cv::Mat coverage_png(const camera::CalibrationResult& r, int camera, int width, 
   return scaled;
 }
 
-cv::Mat uncertainty_png(const camera::UncertaintyMap& m, int width, int height) {
+cv::Mat uncertainty_png(const UncertaintyMap& m, int width, int height) {
   cv::Mat grid(m.rows, m.cols, CV_64F);
   for (int r = 0; r < m.rows; ++r) {
     for (int c = 0; c < m.cols; ++c)
@@ -251,4 +250,4 @@ cv::Mat uncertainty_png(const camera::UncertaintyMap& m, int width, int height) 
   return out;
 }
 
-}  // namespace rigcal::io
+}  // namespace rigcal::camera

@@ -1,4 +1,4 @@
-#include "rigcal/io/bench_report.h"
+#include "rigcal/bench/report.h"
 
 #include <fmt/format.h>
 
@@ -8,14 +8,14 @@
 #include "rigcal/core/error.h"
 #include "rigcal/core/version.h"
 #include "rigcal/io/files.h"
-#include "rigcal/io/svg_plot.h"
+#include "rigcal/report/svg_plot.h"
 
-namespace rigcal::io {
+namespace rigcal::bench {
 namespace fs = std::filesystem;
 
 namespace {
 
-nlohmann::json stats_json(const bench::Stats& s) {
+nlohmann::json stats_json(const Stats& s) {
   return {{"n", s.n},     {"rmse", s.rmse}, {"mean", s.mean}, {"median", s.median},
           {"std", s.std}, {"min", s.min},   {"max", s.max},   {"sse", s.sse}};
 }
@@ -27,13 +27,12 @@ nlohmann::json number_or_null(bool ok, double v) {
 
 }  // namespace
 
-nlohmann::json bench_json(const bench::EvalResult& r,
-                          const std::map<std::string, std::string>& inputs) {
+nlohmann::json bench_json(const EvalResult& r, const std::map<std::string, std::string>& inputs) {
   nlohmann::json j;
   j["tool_version"] = version_string();
-  j["convention"] = bench::to_string(r.convention);
+  j["convention"] = to_string(r.convention);
   j["inputs"] = inputs;
-  j["association"] = bench::to_string(r.association);
+  j["association"] = to_string(r.association);
   j["n_gt"] = r.n_gt;
   j["n_est"] = r.n_est;
   j["n_pairs"] = r.n_pairs;
@@ -41,7 +40,7 @@ nlohmann::json bench_json(const bench::EvalResult& r,
   const Eigen::Matrix4d T = r.alignment.T_gt_est.matrix();
   nlohmann::json rows = nlohmann::json::array();
   for (int i = 0; i < 4; ++i) rows.push_back({T(i, 0), T(i, 1), T(i, 2), T(i, 3)});
-  j["align"] = {{"method", bench::to_string(r.alignment.method)},
+  j["align"] = {{"method", to_string(r.alignment.method)},
                 {"T", rows},
                 {"scale", r.alignment.scale},
                 {"n_used", r.alignment.n_used}};
@@ -51,7 +50,7 @@ nlohmann::json bench_json(const bench::EvalResult& r,
     j["ate"]["trans"]["vbr_sqrt_mean"] = *r.vbr_ate_trans;
     j["ate"]["rot"]["vbr_sqrt_mean"] = *r.vbr_ate_rot;
   }
-  for (const bench::RpeResult& rpe : r.rpe) {
+  for (const RpeResult& rpe : r.rpe) {
     nlohmann::json k;
     k["definition"] = rpe.definition;
     k["n_segments"] = rpe.drift.n_segments;
@@ -66,7 +65,7 @@ nlohmann::json bench_json(const bench::EvalResult& r,
     }
     if (!rpe.segments.empty()) {
       nlohmann::json segs = nlohmann::json::array();
-      for (const bench::Segment& s : rpe.segments) {
+      for (const Segment& s : rpe.segments) {
         segs.push_back({s.first, s.last, s.length, s.trans, s.rot_deg});
       }
       k["segments"] = {{"columns", {"first", "last", "length_m", "trans_m", "rot_deg"}},
@@ -78,36 +77,36 @@ nlohmann::json bench_json(const bench::EvalResult& r,
   return j;
 }
 
-void write_bench_report(const bench::EvalResult& r, const fs::path& dir,
+void write_bench_report(const EvalResult& r, const fs::path& dir,
                         const std::map<std::string, std::string>& inputs) {
-  Plot top;
+  report::Plot top;
   top.title = "Trajectories, top view (estimate coloured by ATE)";
   top.x_label = "x [m]";
   top.y_label = "y [m]";
   top.value_label = "ATE [m]";
   top.equal_axes = true;
-  PlotSeries gt{"ground truth", {}, {}, {}}, est{"estimate", {}, {}, r.ate_trans_errors};
+  report::PlotSeries gt{"ground truth", {}, {}, {}}, est{"estimate", {}, {}, r.ate_trans_errors};
   for (size_t i = 0; i < r.p_gt.size(); ++i) {
     gt.x.push_back(r.p_gt[i].x()), gt.y.push_back(r.p_gt[i].y());
     est.x.push_back(r.p_est_aligned[i].x()), est.y.push_back(r.p_est_aligned[i].y());
   }
   top.series = {gt, est};
-  Plot along;
+  report::Plot along;
   along.title = "ATE along the trajectory";
   along.x_label = "time since the first pair [s]";
   along.y_label = "translation error [m]";
-  PlotSeries e{"ATE", {}, r.ate_trans_errors, {}};
+  report::PlotSeries e{"ATE", {}, r.ate_trans_errors, {}};
   for (const Time& t : r.stamps) e.x.push_back((t - r.stamps.front()).seconds());
   along.series = {e};
-  write_files_atomic({{dir / "bench.json", bench_json(r, inputs).dump(2) + "\n"},
-                      {dir / "trajectory_top.svg", render_svg(top)},
-                      {dir / "ate_along.svg", render_svg(along)}});
+  io::write_files_atomic({{dir / "bench.json", bench_json(r, inputs).dump(2) + "\n"},
+                          {dir / "trajectory_top.svg", report::render_svg(top)},
+                          {dir / "ate_along.svg", report::render_svg(along)}});
 }
 
-bench::LeaderboardInput load_leaderboard_input(const fs::path& gt_dir, const fs::path& est_dir,
-                                               const std::string& methods,
-                                               const TrajectoryReadOptions& read_options,
-                                               bench::LeaderboardInput in) {
+LeaderboardInput load_leaderboard_input(const fs::path& gt_dir, const fs::path& est_dir,
+                                        const std::string& methods,
+                                        const io::TrajectoryReadOptions& read_options,
+                                        LeaderboardInput in) {
   std::error_code ec;
   if (!fs::is_directory(gt_dir, ec)) throw Error(fmt::format("{}: not a folder", gt_dir.string()));
   if (!fs::is_directory(est_dir, ec))
@@ -124,7 +123,7 @@ bench::LeaderboardInput load_leaderboard_input(const fs::path& gt_dir, const fs:
     throw Error(fmt::format("{}: no <sequence>_gt.txt files", gt_dir.string()));
   for (const std::string& seq : in.sequences) {
     in.ground_truths.push_back(
-        read_trajectory(gt_dir / (seq + "_gt.txt"), read_options).trajectory);
+        io::read_trajectory(gt_dir / (seq + "_gt.txt"), read_options).trajectory);
   }
   std::vector<fs::path> folders;
   if (methods.empty()) {
@@ -149,7 +148,7 @@ bench::LeaderboardInput load_leaderboard_input(const fs::path& gt_dir, const fs:
       const fs::path file = folder / (seq + "_es.txt");
       try {
         if (!fs::exists(file)) throw Error(fmt::format("missing {}", file.string()));
-        in.estimates.back().push_back(read_trajectory(file, read_options).trajectory);
+        in.estimates.back().push_back(io::read_trajectory(file, read_options).trajectory);
         in.problems.back().emplace_back();
       } catch (const Error& e) {
         in.estimates.back().emplace_back(std::nullopt);
@@ -160,7 +159,7 @@ bench::LeaderboardInput load_leaderboard_input(const fs::path& gt_dir, const fs:
   return in;
 }
 
-std::string leaderboard_markdown(const bench::Leaderboard& b) {
+std::string leaderboard_markdown(const Leaderboard& b) {
   std::string out = fmt::format(
       "| rank | method | RPE rank | ATE rank | failed |{}\n|---|---|---|---|---|{}\n",
       fmt::format("{}", fmt::join(b.sequences, " RPE % / ATE m |")) +
@@ -171,10 +170,10 @@ std::string leaderboard_markdown(const bench::Leaderboard& b) {
         return s;
       }());
   for (size_t i = 0; i < b.rows.size(); ++i) {
-    const bench::MethodRow& row = b.rows[i];
+    const MethodRow& row = b.rows[i];
     out += fmt::format("| {} | {} | {:.4f} | {:.4f} | {} |", i + 1, row.method, row.rpe_rank,
                        row.ate_rank, row.n_failed);
-    for (const bench::Entry& e : row.entries) {
+    for (const Entry& e : row.entries) {
       out += e.ok ? fmt::format(" {:.4f} / {:.4f} |", e.rpe_pct, e.ate) : " failed |";
     }
     out += "\n";
@@ -183,15 +182,15 @@ std::string leaderboard_markdown(const bench::Leaderboard& b) {
       "\nConvention {}. RPE: {}; ATE: {}. Rank = sum over sequences of max(0, threshold - error) "
       "(RPE threshold {} %, ATE threshold {} m): the area under the cumulative curve up to the "
       "threshold. Failed or missing sequences add 0.\n",
-      bench::to_string(b.convention), b.rpe_definition, b.ate_definition, b.rpe_max, b.ate_max);
+      to_string(b.convention), b.rpe_definition, b.ate_definition, b.rpe_max, b.ate_max);
   return out;
 }
 
-std::string leaderboard_csv(const bench::Leaderboard& b) {
+std::string leaderboard_csv(const Leaderboard& b) {
   std::string out = "method,sequence,ok,rpe_trans_pct,rpe_rot_deg_per_m,ate_m,problem\n";
-  for (const bench::MethodRow& row : b.rows) {
+  for (const MethodRow& row : b.rows) {
     for (size_t s = 0; s < b.sequences.size(); ++s) {
-      const bench::Entry& e = row.entries[s];
+      const Entry& e = row.entries[s];
       std::string problem = e.problem;
       std::replace(problem.begin(), problem.end(), '"', '\'');
       out += fmt::format("{},{},{},{},{},{},\"{}\"\n", row.method, b.sequences[s], e.ok ? 1 : 0,
@@ -203,22 +202,22 @@ std::string leaderboard_csv(const bench::Leaderboard& b) {
   return out;
 }
 
-nlohmann::json leaderboard_json(const bench::Leaderboard& b) {
+nlohmann::json leaderboard_json(const Leaderboard& b) {
   nlohmann::json j;
   j["tool_version"] = version_string();
-  j["convention"] = bench::to_string(b.convention);
+  j["convention"] = to_string(b.convention);
   j["sequences"] = b.sequences;
   j["rpe_definition"] = b.rpe_definition;
   j["ate_definition"] = b.ate_definition;
   j["rpe_threshold_pct"] = b.rpe_max;
   j["ate_threshold_m"] = b.ate_max;
-  for (const bench::MethodRow& row : b.rows) {
+  for (const MethodRow& row : b.rows) {
     nlohmann::json m{{"method", row.method},
                      {"rpe_rank", row.rpe_rank},
                      {"ate_rank", row.ate_rank},
                      {"n_failed", row.n_failed}};
     for (size_t s = 0; s < b.sequences.size(); ++s) {
-      const bench::Entry& e = row.entries[s];
+      const Entry& e = row.entries[s];
       m["sequences"][b.sequences[s]] = {{"ok", e.ok},
                                         {"rpe_trans_pct", number_or_null(e.ok, e.rpe_pct)},
                                         {"rpe_rot_deg_per_m", number_or_null(e.ok, e.rpe_rot)},
@@ -230,33 +229,31 @@ nlohmann::json leaderboard_json(const bench::Leaderboard& b) {
   return j;
 }
 
-void write_leaderboard_report(const bench::Leaderboard& b, const fs::path& dir) {
-  Plot ate, rpe;
+void write_leaderboard_report(const Leaderboard& b, const fs::path& dir) {
+  report::Plot ate, rpe;
   ate.title = "Cumulative ATE: fraction of sequences under an error";
   ate.x_label = "ATE [m]";
   rpe.title = "Cumulative RPE: fraction of sequences under an error";
   rpe.x_label = "RPE [%]";
   ate.y_label = rpe.y_label = "fraction of sequences";
   ate.step = rpe.step = true;
-  for (const bench::MethodRow& row : b.rows) {
+  for (const MethodRow& row : b.rows) {
     std::vector<double> a, r;
-    for (const bench::Entry& e : row.entries) {
+    for (const Entry& e : row.entries) {
       a.push_back(e.ok ? e.ate : INFINITY);
       r.push_back(e.ok ? e.rpe_pct : INFINITY);
     }
-    PlotSeries sa{row.method, {}, {}, {}}, sr{row.method, {}, {}, {}};
-    for (const auto& [x, y] : bench::cumulative_curve(a, b.ate_max))
-      sa.x.push_back(x), sa.y.push_back(y);
-    for (const auto& [x, y] : bench::cumulative_curve(r, b.rpe_max))
-      sr.x.push_back(x), sr.y.push_back(y);
+    report::PlotSeries sa{row.method, {}, {}, {}}, sr{row.method, {}, {}, {}};
+    for (const auto& [x, y] : cumulative_curve(a, b.ate_max)) sa.x.push_back(x), sa.y.push_back(y);
+    for (const auto& [x, y] : cumulative_curve(r, b.rpe_max)) sr.x.push_back(x), sr.y.push_back(y);
     ate.series.push_back(sa);
     rpe.series.push_back(sr);
   }
-  write_files_atomic({{dir / "leaderboard.md", leaderboard_markdown(b)},
-                      {dir / "leaderboard.csv", leaderboard_csv(b)},
-                      {dir / "leaderboard.json", leaderboard_json(b).dump(2) + "\n"},
-                      {dir / "cumulative_ate.svg", render_svg(ate)},
-                      {dir / "cumulative_rpe.svg", render_svg(rpe)}});
+  io::write_files_atomic({{dir / "leaderboard.md", leaderboard_markdown(b)},
+                          {dir / "leaderboard.csv", leaderboard_csv(b)},
+                          {dir / "leaderboard.json", leaderboard_json(b).dump(2) + "\n"},
+                          {dir / "cumulative_ate.svg", report::render_svg(ate)},
+                          {dir / "cumulative_rpe.svg", report::render_svg(rpe)}});
 }
 
-}  // namespace rigcal::io
+}  // namespace rigcal::bench

@@ -1,10 +1,10 @@
-#include "rigcal/io/png.h"
+#include "rigcal/report/png.h"
 
 #include <opencv2/imgcodecs.hpp>
 
 #include "rigcal/core/error.h"
 
-namespace rigcal::io {
+namespace rigcal::report {
 
 std::string encode_png(const cv::Mat& image) {
   std::vector<uchar> buffer;
@@ -12,4 +12,4 @@ std::string encode_png(const cv::Mat& image) {
   return std::string(buffer.begin(), buffer.end());
 }
 
-}  // namespace rigcal::io
+}  // namespace rigcal::report

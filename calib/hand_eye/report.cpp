@@ -1,27 +1,21 @@
-#include "rigcal/io/hand_eye_report.h"
+#include "rigcal/hand_eye/report.h"
 
 #include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
 #include "rigcal/core/version.h"
-#include "rigcal/io/svg_plot.h"
+#include "rigcal/report/json.h"
+#include "rigcal/report/svg_plot.h"
 
-namespace rigcal::io {
-namespace {
-
-nlohmann::json vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
-
-}  // namespace
-
-std::vector<OutputFile> hand_eye_report_files(const std::filesystem::path& dir,
-                                              const HandEyeInputs& in,
-                                              const std::vector<hand_eye::MotionPair>& pairs,
-                                              const hand_eye::ClosedForm& cf,
-                                              const hand_eye::Refined& r, const Trajectory& lidar,
-                                              const Trajectory& gnss) {
-  std::vector<OutputFile> files;
-  const hand_eye::Observability& ob = cf.observability;
+namespace rigcal::hand_eye {
+std::vector<io::OutputFile> hand_eye_report_files(const std::filesystem::path& dir,
+                                                  const HandEyeInputs& in,
+                                                  const std::vector<MotionPair>& pairs,
+                                                  const ClosedForm& cf, const Refined& r,
+                                                  const Trajectory& lidar, const Trajectory& gnss) {
+  std::vector<io::OutputFile> files;
+  const Observability& ob = cf.observability;
   const SE3& X = r.T_gnss_lidar;
   const Eigen::Vector3d rpy = roll_pitch_yaw(X.R) * 180.0 / M_PI;
   const Eigen::Vector3d &sig_r = r.rotation_sigma_deg, &sig_t = r.translation_sigma_m;
@@ -38,32 +32,35 @@ std::vector<OutputFile> hand_eye_report_files(const std::filesystem::path& dir,
                  {"spacings_s", in.spacings_s},
                  {"stride_s", in.stride_s},
                  {"min_rotation_deg", in.min_rotation_deg}};
-  j["T_gnss_lidar"] = {{"t_m", vec(X.t)},
-                       {"roll_pitch_yaw_deg", vec(rpy)},
-                       {"t_sigma_m", vec(sig_t)},
-                       {"rotation_sigma_deg", vec(sig_r)},
+  j["T_gnss_lidar"] = {{"t_m", report::vector_json(X.t)},
+                       {"roll_pitch_yaw_deg", report::vector_json(rpy)},
+                       {"t_sigma_m", report::vector_json(sig_t)},
+                       {"rotation_sigma_deg", report::vector_json(sig_r)},
                        {"matrix", {X.matrix().row(0), X.matrix().row(1), X.matrix().row(2)}}};
   if (r.time_offset_sigma_s > 0) {  // estimated (--estimate-offset): refined with X
     j["clock_offset"] = {{"gnss_time_offset_s", in.gnss_time_offset_s},
                          {"sigma_s", r.time_offset_sigma_s},
                          {"correction_in_refinement_s", r.time_offset_correction_s}};
   }
-  j["closed_form"] = {{"t_m", vec(cf.T_gnss_lidar.t)},
-                      {"roll_pitch_yaw_deg", vec(roll_pitch_yaw(cf.T_gnss_lidar.R) * 180 / M_PI)},
-                      {"axis_residual_rms_deg", cf.rotation_residual_rms_deg},
-                      {"pairs_left_out_by_consensus", cf.rejected}};
+  j["closed_form"] = {
+      {"t_m", report::vector_json(cf.T_gnss_lidar.t)},
+      {"roll_pitch_yaw_deg", report::vector_json(roll_pitch_yaw(cf.T_gnss_lidar.R) * 180 / M_PI)},
+      {"axis_residual_rms_deg", cf.rotation_residual_rms_deg},
+      {"pairs_left_out_by_consensus", cf.rejected}};
   nlohmann::json unobs = nlohmann::json::array();
-  for (int i : ob.unobservable) unobs.push_back(vec(ob.translation_directions.col(i)));
+  for (int i : ob.unobservable)
+    unobs.push_back(report::vector_json(ob.translation_directions.col(i)));
   j["observability"] = {
-      {"rotation_singular_values_rad", vec(ob.rotation_singular_values)},
+      {"rotation_singular_values_rad", report::vector_json(ob.rotation_singular_values)},
       {"near_planar", ob.near_planar},
-      {"near_planar_ratio", hand_eye::kNearPlanarRatio},
-      {"dominant_rotation_axis", vec(ob.dominant_axis)},
-      {"translation_singular_values", vec(ob.translation_singular_values)},
+      {"near_planar_ratio", kNearPlanarRatio},
+      {"dominant_rotation_axis", report::vector_json(ob.dominant_axis)},
+      {"translation_singular_values", report::vector_json(ob.translation_singular_values)},
       {"translation_directions",
-       {vec(ob.translation_directions.col(0)), vec(ob.translation_directions.col(1)),
-        vec(ob.translation_directions.col(2))}},
-      {"translation_sigma_m", vec(ob.translation_sigma_m)},
+       {report::vector_json(ob.translation_directions.col(0)),
+        report::vector_json(ob.translation_directions.col(1)),
+        report::vector_json(ob.translation_directions.col(2))}},
+      {"translation_sigma_m", report::vector_json(ob.translation_sigma_m)},
       {"unobservable_directions", unobs},
       {"max_sigma_m", in.max_sigma_m}};
   j["noise_scale"] = r.noise_scale;
@@ -74,7 +71,7 @@ std::vector<OutputFile> hand_eye_report_files(const std::filesystem::path& dir,
       {"value", r.odometry_scale},
       {"sigma", r.odometry_scale_sigma}};
   nlohmann::json levels = nlohmann::json::array();
-  for (const hand_eye::Refined::PairNoise& n : r.pair_noise) {
+  for (const Refined::PairNoise& n : r.pair_noise) {
     levels.push_back({{"length_s", n.length_s},
                       {"pairs", n.pairs},
                       {"rotation_deg", n.rotation_deg},
@@ -98,27 +95,27 @@ std::vector<OutputFile> hand_eye_report_files(const std::filesystem::path& dir,
   j["pairs"] = pj;
   files.push_back({dir / "hand_eye.json", j.dump(2) + "\n"});
   // Residuals over time.
-  Plot p;
+  report::Plot p;
   p.title = "Per-pair residuals after the solve";
   p.x_label = "t0 (s since the first pair)";
   p.y_label = "translation residual (mm)";
-  PlotSeries s{"translation", {}, {}, {}};
+  report::PlotSeries s{"translation", {}, {}, {}};
   for (size_t k = 0; k < pairs.size(); ++k) {
     s.x.push_back((pairs[k].t0 - pairs.front().t0).seconds());
     s.y.push_back(1e3 * r.pair_translation_residual_m[k]);
   }
   s.values.assign(s.x.size(), 0.0);
   p.series = {s};
-  files.push_back({dir / "residuals.png", render_png(p)});
+  files.push_back({dir / "residuals.png", report::render_png(p)});
   // The GNSS/INS positions and the LiDAR odometry carried into the GNSS/INS frame through X,
   // aligned at the middle pair.
-  const hand_eye::MotionPair& mid = pairs[pairs.size() / 2];
-  Plot top;
+  const MotionPair& mid = pairs[pairs.size() / 2];
+  report::Plot top;
   top.title = "Top view: GNSS/INS and LiDAR odometry through the extrinsic";
   top.x_label = "x (m)";
   top.y_label = "y (m)";
   top.equal_axes = true;
-  PlotSeries gs{"GNSS/INS", {}, {}, {}}, ls{"LiDAR via X", {}, {}, {}};
+  report::PlotSeries gs{"GNSS/INS", {}, {}, {}}, ls{"LiDAR via X", {}, {}, {}};
   for (const SE3& T : gnss.T_world_body) gs.x.push_back(T.t.x()), gs.y.push_back(T.t.y());
   // T_enu_odom from the middle pair's start: T_enu_G(t0) X T_odom_L(t0)^-1.
   const auto find = [&](const Trajectory& tr, Time t) {
@@ -133,8 +130,8 @@ std::vector<OutputFile> hand_eye_report_files(const std::filesystem::path& dir,
     ls.x.push_back(G.t.x()), ls.y.push_back(G.t.y());
   }
   top.series = {gs, ls};
-  files.push_back({dir / "trajectories.png", render_png(top)});
+  files.push_back({dir / "trajectories.png", report::render_png(top)});
   return files;
 }
 
-}  // namespace rigcal::io
+}  // namespace rigcal::hand_eye

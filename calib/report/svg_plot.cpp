@@ -1,4 +1,4 @@
-#include "rigcal/io/svg_plot.h"
+#include "rigcal/report/svg_plot.h"
 
 #include <fmt/format.h>
 
@@ -8,9 +8,9 @@
 #include <limits>
 #include <opencv2/imgproc.hpp>
 
-#include "rigcal/io/png.h"
+#include "rigcal/report/png.h"
 
-namespace rigcal::io {
+namespace rigcal::report {
 namespace {
 
 constexpr double kW = 900, kH = 620, kLeft = 80, kRight = 150, kTop = 50, kBottom = 60;
@@ -183,9 +183,9 @@ std::string render_svg(const Plot& plot) {
   return out;
 }
 
-}  // namespace rigcal::io
+}  // namespace rigcal::report
 
-namespace rigcal::io {
+namespace rigcal::report {
 
 std::string render_png(const Plot& plot) {
   const double pw = kW - kLeft - kRight, ph = kH - kTop - kBottom;
@@ -245,4 +245,4 @@ std::string render_png(const Plot& plot) {
   return encode_png(img);
 }
 
-}  // namespace rigcal::io
+}  // namespace rigcal::report

@@ -1,4 +1,4 @@
-#include "rigcal/io/lidar_camera_report.h"
+#include "rigcal/lidar_camera/report.h"
 
 #include <fmt/format.h>
 
@@ -8,15 +8,10 @@
 #include "rigcal/camera/lens.h"
 #include "rigcal/core/se3.h"
 #include "rigcal/core/version.h"
-#include "rigcal/io/png.h"
+#include "rigcal/report/json.h"
+#include "rigcal/report/png.h"
 
-namespace rigcal::io {
-namespace {
-
-std::vector<double> vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
-
-}  // namespace
-
+namespace rigcal::lidar_camera {
 cv::Mat overlay(const cv::Mat& image, const std::vector<Eigen::Vector3d>& scan,
                 const std::vector<Eigen::Vector3d>& board_points, const SE3& T,
                 const rig::CameraModel& camera) {
@@ -50,13 +45,13 @@ cv::Mat overlay(const cv::Mat& image, const std::vector<Eigen::Vector3d>& scan,
   return out;
 }
 
-std::vector<OutputFile> lidar_camera_report_files(const std::filesystem::path& dir,
-                                                  const LidarCameraInputs& in,
-                                                  const std::vector<lidar_camera::PairInput>& pairs,
-                                                  const lidar_camera::Calibration& c,
-                                                  const rig::CameraModel& camera,
-                                                  const std::vector<cv::Mat>& images) {
-  const lidar_camera::Solution& s = c.solution;
+std::vector<io::OutputFile> lidar_camera_report_files(const std::filesystem::path& dir,
+                                                      const LidarCameraInputs& in,
+                                                      const std::vector<PairInput>& pairs,
+                                                      const Calibration& c,
+                                                      const rig::CameraModel& camera,
+                                                      const std::vector<cv::Mat>& images) {
+  const Solution& s = c.solution;
   nlohmann::json j;
   j["tool_version"] = version_string();
   j["definition"] =
@@ -70,11 +65,12 @@ std::vector<OutputFile> lidar_camera_report_files(const std::filesystem::path& d
                  {"board_width_m", in.board_width_m},
                  {"board_height_m", in.board_height_m}};
   const SE3& T = s.T_camera_lidar;
-  j["T_camera_lidar"] = {{"t_m", vec(T.t)},
-                         {"roll_pitch_yaw_deg", vec(roll_pitch_yaw(T.R) * 180.0 / M_PI)},
-                         {"t_sigma_m", vec(s.translation_sigma_m)},
-                         {"rotation_sigma_deg", vec(s.rotation_sigma_deg)},
-                         {"matrix", {T.matrix().row(0), T.matrix().row(1), T.matrix().row(2)}}};
+  j["T_camera_lidar"] = {
+      {"t_m", report::vector_json(T.t)},
+      {"roll_pitch_yaw_deg", report::vector_json(roll_pitch_yaw(T.R) * 180.0 / M_PI)},
+      {"t_sigma_m", report::vector_json(s.translation_sigma_m)},
+      {"rotation_sigma_deg", report::vector_json(s.rotation_sigma_deg)},
+      {"matrix", {T.matrix().row(0), T.matrix().row(1), T.matrix().row(2)}}};
   std::vector<std::vector<double>> cov;
   for (int r = 0; r < 6; ++r)
     cov.push_back({s.covariance.row(r).data(), s.covariance.row(r).data() + 6});
@@ -82,11 +78,13 @@ std::vector<OutputFile> lidar_camera_report_files(const std::filesystem::path& d
                       "rotation (left tangent, rad) then translation (m); scaled by the "
                       "residuals' level when above 1"},
                      {"matrix", cov}};
-  j["closed_form"] = {{"t_m", vec(s.closed_form.t)},
-                      {"roll_pitch_yaw_deg", vec(roll_pitch_yaw(s.closed_form.R) * 180 / M_PI)}};
-  j["observability"] = {{"normal_singular_values", vec(s.observability.singular_values)},
-                        {"condition", s.observability.condition},
-                        {"weak_direction_camera", vec(s.observability.weak_direction)}};
+  j["closed_form"] = {
+      {"t_m", report::vector_json(s.closed_form.t)},
+      {"roll_pitch_yaw_deg", report::vector_json(roll_pitch_yaw(s.closed_form.R) * 180 / M_PI)}};
+  j["observability"] = {
+      {"normal_singular_values", report::vector_json(s.observability.singular_values)},
+      {"condition", s.observability.condition},
+      {"weak_direction_camera", report::vector_json(s.observability.weak_direction)}};
   j["noise_scale"] = s.noise_scale;
   nlohmann::json pj = nlohmann::json::array();
   size_t used = 0;
@@ -97,7 +95,7 @@ std::vector<OutputFile> lidar_camera_report_files(const std::filesystem::path& d
                         {"note", c.pairs[k].note}};
     if (pairs[k].camera) p["camera_reprojection_rms_px"] = pairs[k].camera->rms_px;
     if (c.pairs[k].used) {
-      const lidar_camera::PairResidual& r = s.residuals[used++];
+      const PairResidual& r = s.residuals[used++];
       p["board_points"] = c.pairs[k].lidar.points.size();
       p["board_rectangle_m"] = {c.pairs[k].lidar.width_m, c.pairs[k].lidar.height_m};
       p["lidar_plane_rms_m"] = c.pairs[k].lidar.plane_rms_m;
@@ -110,13 +108,13 @@ std::vector<OutputFile> lidar_camera_report_files(const std::filesystem::path& d
     pj.push_back(p);
   }
   j["pairs"] = pj;
-  std::vector<OutputFile> files{{dir / "lidar_camera.json", j.dump(2) + "\n"}};
+  std::vector<io::OutputFile> files{{dir / "lidar_camera.json", j.dump(2) + "\n"}};
   for (size_t k = 0; k < pairs.size() && k < images.size(); ++k) {
-    files.push_back(
-        {dir / fmt::format("pair_{:02d}.png", k + 1),
-         encode_png(overlay(images[k], pairs[k].scan, c.pairs[k].lidar.points, T, camera))});
+    files.push_back({dir / fmt::format("pair_{:02d}.png", k + 1),
+                     report::encode_png(
+                         overlay(images[k], pairs[k].scan, c.pairs[k].lidar.points, T, camera))});
   }
   return files;
 }
 
-}  // namespace rigcal::io
+}  // namespace rigcal::lidar_camera
