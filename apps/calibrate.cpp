@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <cmath>
 #include <memory>
 
 #include "cli.h"
@@ -27,7 +28,9 @@ void print_table(const session::CalibrateResult& r) {
     std::string result;
     for (const report::Figure& f : s.residuals) {
       if (result.size() > 60) break;
-      result += fmt::format("{}{} {:.4g}{}", result.empty() ? "" : ", ", f.name, f.value,
+      const bool whole = f.value == std::floor(f.value) && std::abs(f.value) < 1e9;
+      result += fmt::format("{}{} {}{}", result.empty() ? "" : ", ", f.name,
+                            whole ? fmt::format("{:.0f}", f.value) : fmt::format("{:.4g}", f.value),
                             f.unit.empty() || f.name.ends_with(f.unit) ? "" : " " + f.unit);
     }
     fmt::print("  {:<13} {:<13} {:>8}  {}\n", s.step, s.status,

@@ -321,7 +321,8 @@ std::vector<std::string> vbr_drops(const Rig& rig) {
   std::vector<std::string> out;
   std::vector<std::string> offsets, drifts, attached;
   for (const Sensor& s : rig.sensors) {
-    if (s.time_offset != 0.0) offsets.push_back(fmt::format("{} {} s", s.name, s.time_offset));
+    if (s.time_offset != 0.0)
+      offsets.push_back(fmt::format("{} {:.3f} ms", s.name, 1e3 * s.time_offset));
     if (s.time_drift_ppm) drifts.push_back(fmt::format("{} {} ppm", s.name, *s.time_drift_ppm));
     if (!s.attached_to.empty()) attached.push_back(fmt::format("{} to {}", s.name, s.attached_to));
   }

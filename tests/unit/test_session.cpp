@@ -327,6 +327,52 @@ TEST_F(Session, CalibrateNamesTheFailedStepThenRerunsOnlyIt) {
   EXPECT_FALSE(fs::exists(dir_ / "vbr" / "campus" / "vbr_calib.yaml"));
 }
 
+// --only and --from, and a step the data do not determine (exit 3), on the motion recording.
+TEST_F(Session, OnlyFromAndAnUndeterminedStep) {
+  const fs::path session = motion_session(), out = dir_ / "calibration";
+  const std::string base =
+      fmt::format("calibrate {} --out {} --rig {}", session.string(), out.string(), kPrior);
+  const CliRun only = rigcal_cli(base + " --only time_sync", dir_);
+  EXPECT_EQ(only.status, 0) << only.err;
+  EXPECT_NE(only.out.find("== time_sync: ok"), std::string::npos) << only.out;
+  EXPECT_EQ(only.out.find("== cameras"), std::string::npos) << only.out;
+  EXPECT_NE(only.err.find("nothing published: cameras (not run)"), std::string::npos) << only.err;
+  EXPECT_FALSE(fs::exists(out / "calib.yaml"));
+  // hand_eye alone: time_sync comes from the cache.
+  const CliRun he = rigcal_cli(base + " --only hand_eye", dir_);
+  EXPECT_EQ(he.status, 0) << he.err;
+  EXPECT_NE(he.out.find("== time_sync: ok (cached"), std::string::npos) << he.out;
+  EXPECT_NE(he.out.find("== hand_eye: ok\n"), std::string::npos) << he.out;
+  // --from needs the earlier steps cached.
+  const CliRun from = rigcal_cli(base + " --from hand_eye", dir_);
+  EXPECT_EQ(from.status, 2);
+  EXPECT_NE(from.err.find("--from hand_eye: the earlier step cameras has no cached result"),
+            std::string::npos)
+      << from.err;
+  const CliRun bad_step = rigcal_cli(base + " --only handeye", dir_);
+  EXPECT_EQ(bad_step.status, 2);
+  EXPECT_NE(bad_step.err.find("the steps are cameras, lidar_camera, time_sync, hand_eye"),
+            std::string::npos)
+      << bad_step.err;
+  // The external IMU held still: no offset, said as undetermined with the remedy, exit 3.
+  std::string imu = slurp(session / "imu" / "data" / "imu.txt");
+  std::string still = imu.substr(0, imu.find('\n') + 1);
+  const std::string row = "0.0,0.0,9.81,0.001,-0.002,0.0005,1.0,0.0,0.0,0.0";
+  size_t lines = 0;
+  for (char c : imu) lines += c == '\n';
+  for (size_t k = 1; k < lines; ++k) {
+    still += row;
+    for (int i = 0; i < 27; ++i) still += ",0.0";
+    still += "\n";
+  }
+  io::write_file_atomic(session / "imu" / "data" / "imu.txt", still);
+  const CliRun u = rigcal_cli(base + " --only time_sync", dir_);
+  EXPECT_EQ(u.status, 3) << u.out << u.err;
+  EXPECT_NE(u.out.find("== time_sync: undetermined"), std::string::npos) << u.out;
+  EXPECT_NE(u.out.find("not enough excitation"), std::string::npos) << u.out;
+  EXPECT_NE(u.out.find("what would settle it: record the two IMUs"), std::string::npos) << u.out;
+}
+
 TEST(Publish, RefusesAnUnknownCalibrationAndReplacesWithForce) {
   const fs::path dir = fs::temp_directory_path() / fmt::format("rigcal_publish_{}", ::getpid());
   fs::remove_all(dir);
