@@ -44,7 +44,7 @@ void print_table(const session::CalibrateResult& r) {
 void run(Options o) {
   o.run.rig = o.rig, o.run.target = o.target, o.run.odometry = o.odometry, o.run.gnss = o.gnss;
   o.run.out = o.out;
-  o.run.cameras.bayer = io::bayer_from_string(o.bayer);
+  o.run.cameras.bayer = o.run.lidar_camera.bayer = io::bayer_from_string(o.bayer);
   o.run.hand_eye.estimate_offset = !o.no_estimate_offset;
   o.run.hand_eye.refine.fixed = hand_eye::parse_translation_constraints(o.fix, false);
   for (const auto& p : hand_eye::parse_translation_constraints(o.prior, true))
@@ -69,6 +69,9 @@ void run(Options o) {
     if (s.status != "ok") open.push_back(fmt::format("{} ({})", s.step, s.status));
   }
   fmt::print(stderr, "rigcal: nothing published: {}\n", fmt::join(open, ", "));
+  if (!r.removed_stale.empty())
+    fmt::print(stderr, "rigcal: removed {}: an earlier run's, it does not match these inputs\n",
+               r.removed_stale.string());
   if (r.exit_status != 0) throw Exit{r.exit_status};
 }
 

@@ -14,7 +14,7 @@ namespace rigcal::cli {
 namespace {
 
 struct Options {
-  std::string target, session, images, scans, rig, out, report, roi, board_size;
+  std::string target, session, images, scans, rig, out, report, roi, board_size, bayer;
   lidar_camera::StepOptions step;
 };
 
@@ -29,6 +29,7 @@ std::vector<double> numbers(const std::string& text, size_t n, const std::string
 void run(Options o) {
   if (o.rig.empty()) throw Error("--rig is needed: the camera's intrinsics come from it");
   const rig::Rig rig = rig::read_rig_file(o.rig);
+  o.step.bayer = io::bayer_from_string(o.bayer);
   if (!o.board_size.empty()) {
     const std::vector<double> v = numbers(o.board_size, 2, "--board-size");
     o.step.board_width_m = v[0], o.step.board_height_m = v[1];
@@ -93,6 +94,8 @@ void add_lidar_camera(CLI::App& app) {
                   "image glob; pairs are matched by the last number in the file names");
   cmd->add_option("--scans", o->scans, "scan glob");
   cmd->add_option("--out", o->out, "output calibration YAML");
+  cmd->add_option("--bayer", o->bayer,
+                  "raw Bayer images: rggb | bggr | grbg | gbrg (demosaiced to gray)");
   cmd->add_option("--report", o->report, "report folder: lidar_camera.json, pair_NN.png");
   cmd->add_option("--board-size", o->board_size,
                   "the physical board W,H in m when larger than the target's outline (a backing "

@@ -8,6 +8,7 @@
 #include "rigcal/core/error.h"
 #include "rigcal/core/se3.h"
 #include "rigcal/core/text.h"
+#include "rigcal/core/version.h"
 #include "rigcal/hand_eye/report.h"
 #include "rigcal/io/gnss_fixes.h"
 
@@ -39,10 +40,19 @@ Trajectory read_gnss(const StepInputs& in, const StepOptions& o,
   return fixes.T_enu_gnss;
 }
 
-report::StepResult undetermined(report::StepResult out, std::string reason, std::string remedy) {
+// No estimate: the report says why, with the inputs and the notes so far.
+report::StepResult undetermined(report::StepResult out, const StepInputs& in, std::string reason,
+                                std::string remedy) {
   out.status = report::StepStatus::undetermined;
   out.reason = std::move(reason);
   out.remedy = std::move(remedy);
+  const nlohmann::json j = {{"tool_version", version_string()},
+                            {"inputs", {{"lidar", in.lidar.string()},
+                                        {"gnss", in.gnss.string()},
+                                        {"rig", in.rig_source}}},
+                            {"notes", out.notes}};
+  out.report_files = {{"hand_eye.json", j.dump(2) + "\n"}};
+  report::finish_report(out, "hand_eye.json");
   return out;
 }
 
@@ -126,7 +136,7 @@ report::StepResult estimate_extrinsic(const StepInputs& in, const StepOptions& o
   if (o.estimate_offset) {
     if (sync.verdict != "ok") {
       return undetermined(
-          out,
+          out, in,
           fmt::format("the clock offset cannot be estimated: {}: {}", sync.verdict, sync.reason),
           "turn the rig about changing axes while both trajectories are recorded, or give the "
           "GNSS/INS time_offset in the rig and do not estimate it");
@@ -205,7 +215,7 @@ report::StepResult estimate_extrinsic(const StepInputs& in, const StepOptions& o
                       "(GNSS/INS frame; {})",
                       d.x(), d.y(), d.z(), why(i)));
     }
-    return undetermined(out, fmt::format("{}", fmt::join(reasons, "; ")),
+    return undetermined(out, in, fmt::format("{}", fmt::join(reasons, "; ")),
                         "give --fix (e.g. z=0.35), --prior (z=0.35,0.02) or a --rig whose "
                         "extrinsic holds it, or record motion that turns about that direction");
   }
@@ -267,7 +277,17 @@ report::StepResult estimate_extrinsic(const StepInputs& in, const StepOptions& o
 
   if (in.rig) {
     // The GNSS/INS placed from the LiDAR; what is rigidly attached to it moves with it.
+    // The GNSS/INS itself whole (pose, and clock below); what is attached to it, its pose.
     out.wrote = rig::move_rigidly(out.rig, o.sensor, T_base_lidar * X.inverse());
+    for (size_t i = 1; i < out.wrote.size(); ++i) {
+      if (out.wrote[i] == o.lidar_sensor) {
+        throw Error(fmt::format(
+            "{}: attached_to {} in {}: the LiDAR would move with the GNSS/INS it is calibrated "
+            "against; attach the GNSS/INS to the LiDAR's mount only through the estimate",
+            o.lidar_sensor, o.sensor, in.rig_source));
+      }
+      out.wrote[i] += ".T_b";
+    }
     if (o.estimate_offset) rig::set_clock_from(out.rig, o.sensor, o.lidar_sensor, offset_s);
   }
   const std::string name = fmt::format("T_{}_{}", o.sensor, o.lidar_sensor);

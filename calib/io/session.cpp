@@ -82,8 +82,13 @@ Session read_session(const fs::path& root) {
         std::pair{"motion", &s.motion}}) {
     if (!p->empty()) continue;
     const fs::path sub = root / default_folder(purpose);
-    if (fs::is_directory(sub) && serves(sub, purpose)) {
-      *p = sub;
+    if (fs::is_directory(sub)) {
+      // A default folder is the purpose's recording, or none: never the root in its place.
+      if (serves(sub, purpose))
+        *p = sub;
+      else
+        s.notes.push_back(fmt::format("{}: lacks the folders {} needs; not used", sub.string(),
+                                      purpose));
     } else if (serves(root, purpose)) {
       *p = root;
     }

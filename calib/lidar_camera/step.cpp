@@ -85,7 +85,7 @@ report::StepResult calibrate_lidar_camera(const StepInputs& in, const StepOption
   std::vector<cv::Mat> shown(in.images.size());
   for (size_t k = 0; k < in.images.size(); ++k) {
     report::tell(progress, "pair", k + 1, in.images.size());
-    const cv::Mat gray = io::read_gray(in.images[k]);
+    const cv::Mat gray = io::read_gray(in.images[k], o.bayer);
     if (gray.cols != cam.width || gray.rows != cam.height) {
       throw Error(fmt::format("{}: {} x {} px, the rig's {} is {} x {}", in.images[k], gray.cols,
                               gray.rows, o.camera, cam.width, cam.height));

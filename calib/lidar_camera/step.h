@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "rigcal/io/image_io.h"
 #include "rigcal/lidar_camera/solve.h"
 #include "rigcal/report/step.h"
 
@@ -18,6 +19,7 @@ struct StepOptions {
   std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> roi;  // LiDAR frame, min and max
   double corner_sigma_px = 0.1;
   double max_dt_s = 0.05;  // a recording's image takes the nearest scan within this
+  io::Bayer bayer = io::Bayer::none;  // raw mosaics: demosaiced to gray
 };
 
 struct StepInputs {

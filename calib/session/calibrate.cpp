@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <map>
+#include <memory>
 
 #include "rigcal/core/error.h"
 #include "rigcal/core/sha256.h"
@@ -29,11 +30,25 @@ struct Plan {
   std::string options;
   std::function<report::StepResult(const rig::Rig&, const report::Progress&)> run;
   std::string cannot_plan;  // why it cannot run (a missing input), else ""
+  std::shared_ptr<bool> reuse_detections;  // cameras: set when the detections cache may be used
 };
 
-std::string fingerprint(const rig::Rig& rig, const std::vector<std::string>& sensors) {
+// An entry "NAME.T_b" stands for that sensor's pose alone, "NAME" for its whole entry.
+bool pose_only(const std::string& entry, std::string& name) {
+  const bool pose = entry.size() > 4 && entry.compare(entry.size() - 4, 4, ".T_b") == 0;
+  name = pose ? entry.substr(0, entry.size() - 4) : entry;
+  return pose;
+}
+
+std::string fingerprint(const rig::Rig& rig, const std::vector<std::string>& entries) {
   std::string out;
-  for (const std::string& name : sensors) {
+  for (const std::string& entry : entries) {
+    std::string name;
+    if (pose_only(entry, name)) {
+      const rig::Sensor* s = rig::find_sensor(rig, name);
+      out += s ? entry + ":\n" + rig::yaml_matrix4_rows(s->T_base_sensor, "") : entry + ": absent\n";
+      continue;
+    }
     const rig::Sensor* s = rig::find_sensor(rig, name);
     if (!s) {
       out += name + ": absent\n";
@@ -132,16 +147,47 @@ std::optional<Cached> read_cache(const fs::path& file, const std::string& key) {
   }
 }
 
+// Copies what a step wrote from its rig into `rig`: whole entries (added where the rig lacks
+// them) or, for "NAME.T_b", the pose alone.
+void apply(rig::Rig& rig, const rig::Rig& step_rig, const std::vector<std::string>& wrote) {
+  for (const std::string& entry : wrote) {
+    std::string name;
+    const bool pose = pose_only(entry, name);
+    const rig::Sensor& from = rig::sensor(step_rig, name);
+    rig::Sensor* to = rig::find_sensor(rig, name);
+    if (!to) {
+      rig.sensors.push_back(from);
+    } else if (pose) {
+      to->T_base_sensor = from.T_base_sensor;
+    } else {
+      *to = from;
+    }
+  }
+}
+
 // Writes the report folder whole: into a fresh sibling, then swapped in.
 void write_report_folder(const fs::path& dir, const std::vector<io::OutputFile>& files) {
   const fs::path fresh = dir.string() + ".new";
   fs::remove_all(fresh);
   std::vector<io::OutputFile> placed;
   for (const io::OutputFile& f : files) placed.push_back({fresh / f.path, f.content});
-  io::write_files_atomic(placed);
-  fs::create_directories(fresh);
-  fs::remove_all(dir);
-  fs::rename(fresh, dir);
+  try {
+    io::write_files_atomic(placed);
+    fs::create_directories(fresh);
+    fs::remove_all(dir);
+    fs::rename(fresh, dir);
+  } catch (...) {
+    std::error_code ec;
+    fs::remove_all(fresh, ec);
+    throw;
+  }
+}
+
+std::string detections_key(const std::vector<HashedInput>& hashed, const CalibrateOptions& o) {
+  Sha256 k;
+  for (const HashedInput& h : hashed) k.update(h.role + " " + h.sha256 + "\n");
+  k.update("bayer " + std::string(io::to_string(o.cameras.bayer)));
+  return k.hex();
 }
 
 std::vector<Plan> make_plans(const CalibrateOptions& o, const io::Session& s,
@@ -171,12 +217,16 @@ std::vector<Plan> make_plans(const CalibrateOptions& o, const io::Session& s,
     p.reads = {"cam_l", "cam_r"};
     p.options = fmt::format("model {} outlier_sigma {} bayer {}", o.cameras.model,
                             o.cameras.outlier_sigma, io::to_string(o.cameras.bayer));
-    p.run = [rec, target, out, opt = o.cameras](const rig::Rig& rig, const report::Progress& pr) {
+    p.reuse_detections = std::make_shared<bool>(false);
+    p.run = [rec, target, out, opt = o.cameras, reuse = p.reuse_detections](
+                const rig::Rig& rig, const report::Progress& pr) {
       camera::StepInputs in;
       in.target = target;
       in.images = io::read_session_images(rec);
       in.rig = rig;
-      in.corners_cache = out / "reports" / "cameras" / "corners.vnl";
+      // Only from a run on these very images, target and Bayer pattern: corners.vnl names images
+      // by path.
+      if (*reuse) in.corners_cache = out / "reports" / "cameras" / "corners.vnl";
       return camera::calibrate_cameras(in, opt, pr);
     };
     plans.push_back(std::move(p));
@@ -194,7 +244,8 @@ std::vector<Plan> make_plans(const CalibrateOptions& o, const io::Session& s,
       p.inputs.emplace_back("scans", rec / "ouster_points");
     }
     p.options = fmt::format(
-        "camera {} lidar {} board {} {} roi {} corner_sigma {} max_dt {}", lo.camera, lo.lidar,
+        "camera {} lidar {} bayer {} board {} {} roi {} corner_sigma {} max_dt {}", lo.camera,
+        lo.lidar, io::to_string(lo.bayer),
         lo.board_width_m.value_or(0), lo.board_height_m.value_or(0),
         lo.roi ? fmt::format("{} {}", fmt::join(lo.roi->first, ","), fmt::join(lo.roi->second, ","))
                : "none",
@@ -218,8 +269,10 @@ std::vector<Plan> make_plans(const CalibrateOptions& o, const io::Session& s,
     p.reads = {"os_imu", "imu"};
     const time_sync::TimeSyncOptions& t = o.time_sync;
     p.options = fmt::format(
-        "max_offset {} min_overlap {} window {} min_excitation {} three_axis {}", t.max_offset_s,
-        t.min_overlap, t.window_s, t.min_excitation_rad_s, t.three_axis);
+        "max_offset {} min_overlap {} window {} min_excitation {} three_axis {} coarse_hz {} "
+        "fine_hz_max {} max_peak_ratio {} min_peak_ncc {}",
+        t.max_offset_s, t.min_overlap, t.window_s, t.min_excitation_rad_s, t.three_axis,
+        t.coarse_hz, t.fine_hz_max, t.max_peak_ratio, t.min_peak_ncc);
     p.run = [rec, t](const rig::Rig& rig, const report::Progress& pr) {
       time_sync::StepInputs in = time_sync::streams_of_recording(rec);
       in.rig = rig;
@@ -250,10 +303,12 @@ std::vector<Plan> make_plans(const CalibrateOptions& o, const io::Session& s,
                            f.value_m, f.sigma_m);
     p.options = fmt::format(
         "sensor {} lidar {} attitude {} spacings {} stride {} min_rotation {} smoothing {} "
-        "rotation_sigma {} translation_sigma {} max_sigma {} estimate_offset {} fixed {}",
+        "rotation_sigma {} translation_sigma {} max_sigma {} estimate_offset {} fixed {} "
+        "duplicates {} max_gap {} huber {} estimate_scale {}",
         h.sensor, h.lidar_sensor, h.attitude, fmt::join(h.pairs.spacings_s, ","), h.pairs.stride_s,
         h.pairs.min_rotation_deg, h.pairs.gnss_half_window_s, h.refine.rotation_sigma_deg,
-        h.refine.translation_sigma_m, h.max_sigma_m, h.estimate_offset, fixed);
+        h.refine.translation_sigma_m, h.max_sigma_m, h.estimate_offset, fixed,
+        static_cast<int>(h.duplicates), h.pairs.max_gap_s, h.refine.huber, h.refine.estimate_scale);
     p.run = [odometry, gnss, h](const rig::Rig& rig, const report::Progress& pr) {
       hand_eye::StepInputs in;
       in.lidar = odometry;
@@ -305,7 +360,7 @@ CalibrateResult calibrate(const CalibrateOptions& o, const Progress& progress) {
       if (rig::find_sensor(probe, o.hand_eye.sensor)) {
         for (const std::string& n : rig::move_rigidly(
                  probe, o.hand_eye.sensor, rig::sensor(probe, o.hand_eye.sensor).T_base_sensor)) {
-          if (std::find(p.reads.begin(), p.reads.end(), n) == p.reads.end()) p.reads.push_back(n);
+          if (n != o.hand_eye.sensor) p.reads.push_back(n + ".T_b");
         }
       }
     }
@@ -313,6 +368,7 @@ CalibrateResult calibrate(const CalibrateOptions& o, const Progress& progress) {
 
   std::vector<StepRecord> records;
   std::map<std::string, std::string> status_of;
+  bool internal = false;
   bool before_from = !o.from.empty();
   for (Plan& p : plans) {
     if (p.step == o.from) before_from = false;
@@ -324,8 +380,10 @@ CalibrateResult calibrate(const CalibrateOptions& o, const Progress& progress) {
     const fs::path cache_file = o.out / "cache" / (p.step + ".json");
     const fs::path report_dir = o.out / "reports" / p.step;
     std::string blocked;
+    bool dependency_not_run = false;
     for (const std::string& d : p.depends_on) {
       if (status_of[d] != "ok") blocked = fmt::format("needs {}, which is {}", d, status_of[d]);
+      dependency_not_run |= status_of[d] == "not run";
     }
     // The key: the files it reads, the rig entries it reads, its options, this version.
     std::vector<HashedInput> hashed;
@@ -341,7 +399,7 @@ CalibrateResult calibrate(const CalibrateOptions& o, const Progress& progress) {
         k.update(fingerprint(result.rig, p.reads));
         for (const HashedInput& h : hashed) k.update(h.role + " " + h.sha256 + "\n");
         key = k.hex();
-      } catch (const Error& e) {
+      } catch (const std::exception& e) {  // unreadable, or a folder behind a looping link
         p.cannot_plan = e.what();
       }
     }
@@ -351,15 +409,31 @@ CalibrateResult calibrate(const CalibrateOptions& o, const Progress& progress) {
       cached = read_cache(cache_file, key);
     if (before_from && !cached) {
       throw Error(fmt::format(
-          "--from {}: the earlier step {} has no cached result for these inputs in {}; run "
-          "without --from first",
-          o.from, p.step, (o.out / "cache").string()));
+          "--from {}: the earlier step {} has no cached result for these inputs in {}{}", o.from,
+          p.step, (o.out / "cache").string(),
+          p.cannot_plan.empty() ? "; run without --from first"
+                                : fmt::format(" (it cannot run: {})", p.cannot_plan)));
+    }
+    if (p.reuse_detections) {
+      // The last run's detections are reused when they came from these images, this target and
+      // this Bayer pattern.
+      *p.reuse_detections = false;
+      try {
+        if (fs::exists(cache_file) && !key.empty()) {
+          const nlohmann::json old = nlohmann::json::parse(io::read_text_file(cache_file));
+          *p.reuse_detections = old.value("detections_key", "") == detections_key(hashed, o);
+        }
+      } catch (const std::exception&) {
+      }
     }
     std::vector<std::string> wrote;
     rig::Rig step_rig;
     if (!o.only.empty() && o.only != p.step && !cached) {
       run.status = "not run";
       run.reason = fmt::format("--only {}", o.only);
+    } else if (dependency_not_run) {
+      run.status = "not run";
+      run.reason = blocked;
     } else if (!p.cannot_plan.empty()) {
       run.status = "failed";
       run.reason = p.cannot_plan;
@@ -370,7 +444,6 @@ CalibrateResult calibrate(const CalibrateOptions& o, const Progress& progress) {
       run = cached->run;
       step_rig = cached->rig;
       wrote = cached->wrote;
-      hashed = cached->inputs;
     } else {
       const auto t0 = std::chrono::steady_clock::now();
       try {
@@ -383,18 +456,22 @@ CalibrateResult calibrate(const CalibrateOptions& o, const Progress& progress) {
         step_rig = r.rig;
         wrote = r.wrote;
         write_report_folder(report_dir, r.report_files);
-        io::write_file_atomic(cache_file,
-                              cache_json(key, run, step_rig, wrote, hashed).dump(2) + "\n");
-      } catch (const Error& e) {
+        nlohmann::json cache = cache_json(key, run, step_rig, wrote, hashed);
+        if (p.reuse_detections) cache["detections_key"] = detections_key(hashed, o);
+        io::write_file_atomic(cache_file, cache.dump(2) + "\n");
+      } catch (const std::exception& e) {
+        // Bad input fails the step; anything else is a bug, said as one; the run goes on.
+        const bool bad_input = dynamic_cast<const Error*>(&e) != nullptr;
         run.status = "failed";
-        run.reason = e.what();
-        fs::remove(cache_file);
-        fs::remove_all(report_dir);
+        run.reason = bad_input ? e.what() : fmt::format("internal error: {}", e.what());
+        internal |= !bad_input;
+        std::error_code ec;
+        fs::remove(cache_file, ec);
+        fs::remove_all(report_dir, ec);
       }
     }
     if (run.status == "ok") {
-      for (const std::string& name : wrote)
-        rig::sensor(result.rig, name) = rig::sensor(step_rig, name);
+      apply(result.rig, step_rig, wrote);
       records.push_back(
           {p.step, run.status, version_string(), "", hashed, run.sigmas, run.residuals});
     }
@@ -404,11 +481,12 @@ CalibrateResult calibrate(const CalibrateOptions& o, const Progress& progress) {
 
   bool failed = false, undetermined = false, all_ok = true;
   for (const StepRun& r : result.steps) {
-    failed |= r.status == "failed" || r.status == "blocked";
+    failed |= r.status == "failed";
     undetermined |= r.status == "undetermined";
     all_ok &= r.status == "ok";
   }
-  result.exit_status = failed ? 2 : undetermined ? 3 : 0;
+  // A blocked step counts through the step that blocked it.
+  result.exit_status = internal ? 1 : failed ? 2 : undetermined ? 3 : 0;
   if (all_ok) {
     auto& meta = result.rig.extra_metadata;
     meta.erase(std::remove_if(meta.begin(), meta.end(),
@@ -418,6 +496,10 @@ CalibrateResult calibrate(const CalibrateOptions& o, const Progress& progress) {
     result.calibration = o.out / "calib.yaml";
     io::write_file_atomic(result.calibration, rig::rig_to_yaml(result.rig));
     result.published = true;
+  } else if (fs::exists(o.out / "calib.yaml")) {
+    // An earlier run's calibration no longer matches these inputs: not left to be published.
+    fs::remove(o.out / "calib.yaml");
+    result.removed_stale = o.out / "calib.yaml";
   }
   return result;
 }

@@ -49,8 +49,9 @@ struct CalibrateOptions {
 
 struct StepRun {
   std::string step;
-  // ok, undetermined (the data do not determine it), failed (bad input), blocked (a step it
-  // depends on did not end ok), not run (--only).
+  // ok, undetermined (the data do not determine it), failed (bad input or an internal error),
+  // blocked (a step it depends on failed or is undetermined), not run (--only, or a step it
+  // depends on was not run).
   std::string status;
   bool cached = false;  // taken from OUT/cache without running
   double seconds = 0;   // running time (0 when cached or not run)
@@ -64,7 +65,10 @@ struct CalibrateResult {
   rig::Rig rig;  // with every step that ended ok written in
   bool published = false;
   std::filesystem::path calibration;  // OUT/calib.yaml when published
-  // 0 published; 2 a step failed on bad input; 3 a step is undetermined (and none failed).
+  // Not published: an earlier run's OUT/calib.yaml, removed since it does not match these inputs.
+  std::filesystem::path removed_stale;
+  // 0 every step that ran is ok (published when all ran); 2 a step failed on bad input; 3 a step
+  // is undetermined (and none failed); 1 a step hit an internal error.
   int exit_status = 0;
 };
 

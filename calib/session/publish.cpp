@@ -53,6 +53,7 @@ std::string published_hash(const fs::path& file) {
   std::ifstream in(file);
   std::string line;
   if (!in || !std::getline(in, line)) return "";
+  if (line.rfind("%YAML", 0) == 0 && !std::getline(in, line)) return "";  // OpenCV's: second
   if (line.rfind(kHeader, 0) != 0) return "";
   return line.substr(kHeader.size());
 }
@@ -73,35 +74,31 @@ PublishResult publish(const fs::path& calibration, const std::vector<fs::path>& 
   std::vector<std::string> refused;
   for (const fs::path& seq : sequences) {
     if (!fs::is_directory(seq))
-      throw Error(
-          fmt::format("{}: not a folder (a sequence folder, <place>/<seq>/)", seq.string()));
+      throw Error(fmt::format("{}: not a folder (a sequence folder, <place>/<seq>/)", seq.string()));
+    // File by file: one holding this calibration is left as it is, one holding another (or a
+    // file rigcal did not publish) is replaced only when forced.
     Published p;
     p.sequence = seq;
-    const fs::path vbr = seq / export_name(rig::ExportFormat::vbr);
-    if (fs::exists(vbr)) {
-      const std::string old = published_hash(vbr);
-      if (old == out.sha256) {
-        p.state = "unchanged";
-        out.sequences.push_back(p);
-        continue;
-      }
-      if (!o.force) {
-        refused.push_back(fmt::format(
-            "{} holds {}", vbr.string(),
-            old.empty() ? "a calibration rigcal did not publish"
-                        : fmt::format("another calibration (sha256 {})", old.substr(0, 12))));
-        continue;
-      }
-      p.state = "replaced";
-    } else {
-      p.state = "written";
-    }
+    bool replaced = false;
     for (rig::ExportFormat f : formats) {
       for (const io::OutputFile& e : rig::export_files(rig, f, seq / export_name(f))) {
+        if (fs::exists(e.path)) {
+          const std::string old = published_hash(e.path);
+          if (old == out.sha256) continue;
+          if (!o.force) {
+            refused.push_back(fmt::format(
+                "{} holds {}", e.path.string(),
+                old.empty() ? "a file rigcal did not publish"
+                            : fmt::format("another calibration (sha256 {})", old.substr(0, 12))));
+            continue;
+          }
+          replaced = true;
+        }
         files.push_back({e.path, with_header(out.sha256, e.content)});
         p.files.push_back(e.path);
       }
     }
+    p.state = p.files.empty() ? "unchanged" : replaced ? "replaced" : "written";
     out.sequences.push_back(p);
   }
   if (!refused.empty()) {

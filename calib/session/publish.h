@@ -1,9 +1,10 @@
 #pragma once
 // Publishing a calibration with recorded sequences (doc/session.md): vbr_calib.yaml, and the
 // chosen exports, into each sequence folder of the VBR layout (<place>/<seq>/vbr_calib.yaml),
-// each carrying the calibration's SHA-256 in its first line. A sequence that holds a different
-// calibration is not replaced unless forced; one holding this calibration already is left as it
-// is. All files of all sequences are written at once, or none.
+// each carrying the calibration's SHA-256 in its first line (OpenCV's: its second). File by file:
+// one holding this calibration is left as it is; one holding another, or a file rigcal did not
+// publish, is not replaced unless forced. All files of all sequences are written at once, or none.
+// Exports of formats not asked for this time are left where an earlier run wrote them.
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -20,7 +21,9 @@ struct PublishOptions {
 struct Published {
   std::filesystem::path sequence;
   std::vector<std::filesystem::path> files;  // written
-  std::string state;  // "written", "replaced" (forced), "unchanged" (this calibration already)
+  // "written", "replaced" (forced over another calibration), "unchanged" (every file holds this
+  // calibration already)
+  std::string state;
 };
 
 struct PublishResult {
@@ -29,7 +32,8 @@ struct PublishResult {
   std::vector<Published> sequences;
 };
 
-// The first line of every published file: "# rigcal calibration sha256: HEX".
+// The first line of every published file (OpenCV's: the second): "# rigcal calibration sha256:
+// HEX".
 std::string published_header(const std::string& sha256);
 // The hash a published file names in its first line, or "" when it names none.
 std::string published_hash(const std::filesystem::path& file);

@@ -52,7 +52,7 @@ report::StepResult estimate_clock(const StepInputs& in, const TimeSyncOptions& t
   const io::RateFile oth = io::read_rates(in.other.path, in.other.read);
   report::tell(progress, "reading the angular rates", 2, 2);
   for (const auto* f : {&ref, &oth}) {
-    if (f->rates.stamps.size() < 2) {
+    if (f->rates.stamps.size() < 10) {
       throw Error(fmt::format("{}: {} samples; an angular-rate stream needs at least 10",
                               (f == &ref ? in.reference.path : in.other.path).string(),
                               f->rates.stamps.size()));

@@ -653,12 +653,16 @@ TEST_F(Cli, HandEyeWritesTheExtrinsicAndRefusesAnUndeterminedDirection) {
   ASSERT_EQ(r.status, 0) << r.err;
   const nlohmann::json jt = nlohmann::json::parse(slurp(fs::path(rep_t) / "hand_eye.json"));
   EXPECT_NEAR(jt["inputs"]["gnss_time_offset_s"].get<double>(), -0.0031, 0.1e-3);
-  // A car without a rig or --fix: the vertical is undetermined; exit 3, nothing written.
+  // A car without a rig or --fix: the vertical is undetermined; exit 3, no rig written, the
+  // report saying why (as every step's: status undetermined, reason, remedy).
   const std::string rep2 = (dir_ / "rep2").string();
   r = run("hand-eye" + args(car) + " --report " + rep2);
   EXPECT_EQ(r.status, 3);
   EXPECT_NE(r.err.find("does not determine the translation"), std::string::npos) << r.err;
-  EXPECT_FALSE(fs::exists(rep2));
+  const nlohmann::json ju = nlohmann::json::parse(slurp(fs::path(rep2) / "hand_eye.json"));
+  EXPECT_EQ(ju["status"], "undetermined");
+  EXPECT_NE(ju["reason"].get<std::string>().find("does not determine"), std::string::npos);
+  fs::remove_all(rep2);
   // With --fix it answers, and holds the value.
   r = run("hand-eye" + args(car) + " --fix z=-0.1399 --report " + rep2);
   ASSERT_EQ(r.status, 0) << r.err;

@@ -152,7 +152,7 @@ TEST_F(Steps, HandEyeMovesTheInsImuWithIt) {
   o.estimate_offset = true;
   const report::StepResult r = hand_eye::estimate_extrinsic(in, o);
   ASSERT_EQ(r.status, report::StepStatus::ok) << r.reason;
-  EXPECT_EQ(r.wrote, (std::vector<std::string>{"gnss", "imu"}));
+  EXPECT_EQ(r.wrote, (std::vector<std::string>{"gnss", "imu.T_b"}));  // the IMU's pose only
   const rig::Rig truth = rig::read_rig_file(kTruth);
   const SE3 e = rig::T_a_b(r.rig, "gnss", "lidar"), t = rig::T_a_b(truth, "gnss", "lidar");
   EXPECT_LT((e.t - t.t).norm(), 0.01);
@@ -185,6 +185,9 @@ TEST_F(Steps, HandEyeMovesTheInsImuWithIt) {
   EXPECT_EQ(u.status, report::StepStatus::undetermined);
   EXPECT_NE(u.reason.find("clock offset"), std::string::npos) << u.reason;
   EXPECT_TRUE(u.wrote.empty());
+  EXPECT_EQ(u.report["status"], "undetermined");
+  EXPECT_EQ(u.report["reason"], u.reason);
+  ASSERT_NE(find_file(u, "hand_eye.json"), nullptr);
 }
 
 TEST(Rig, AttachedSensorsMoveRigidlyAndCyclesAreRefused) {
