@@ -46,11 +46,11 @@ report::StepResult undetermined(report::StepResult out, const StepInputs& in, st
   out.status = report::StepStatus::undetermined;
   out.reason = std::move(reason);
   out.remedy = std::move(remedy);
-  const nlohmann::json j = {{"tool_version", version_string()},
-                            {"inputs", {{"lidar", in.lidar.string()},
-                                        {"gnss", in.gnss.string()},
-                                        {"rig", in.rig_source}}},
-                            {"notes", out.notes}};
+  const nlohmann::json j = {
+      {"tool_version", version_string()},
+      {"inputs",
+       {{"lidar", in.lidar.string()}, {"gnss", in.gnss.string()}, {"rig", in.rig_source}}},
+      {"notes", out.notes}};
   out.report_files = {{"hand_eye.json", j.dump(2) + "\n"}};
   report::finish_report(out, "hand_eye.json");
   return out;

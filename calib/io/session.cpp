@@ -87,8 +87,8 @@ Session read_session(const fs::path& root) {
       if (serves(sub, purpose))
         *p = sub;
       else
-        s.notes.push_back(fmt::format("{}: lacks the folders {} needs; not used", sub.string(),
-                                      purpose));
+        s.notes.push_back(
+            fmt::format("{}: lacks the folders {} needs; not used", sub.string(), purpose));
     } else if (serves(root, purpose)) {
       *p = root;
     }

@@ -18,7 +18,7 @@ struct StepOptions {
   std::optional<double> board_width_m, board_height_m;  // a backing board larger than the target
   std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> roi;  // LiDAR frame, min and max
   double corner_sigma_px = 0.1;
-  double max_dt_s = 0.05;  // a recording's image takes the nearest scan within this
+  double max_dt_s = 0.05;             // a recording's image takes the nearest scan within this
   io::Bayer bayer = io::Bayer::none;  // raw mosaics: demosaiced to gray
 };
 

@@ -29,7 +29,7 @@ struct Plan {
   std::vector<std::string> reads;                        // rig sensors
   std::string options;
   std::function<report::StepResult(const rig::Rig&, const report::Progress&)> run;
-  std::string cannot_plan;  // why it cannot run (a missing input), else ""
+  std::string cannot_plan;                 // why it cannot run (a missing input), else ""
   std::shared_ptr<bool> reuse_detections;  // cameras: set when the detections cache may be used
 };
 
@@ -46,7 +46,8 @@ std::string fingerprint(const rig::Rig& rig, const std::vector<std::string>& ent
     std::string name;
     if (pose_only(entry, name)) {
       const rig::Sensor* s = rig::find_sensor(rig, name);
-      out += s ? entry + ":\n" + rig::yaml_matrix4_rows(s->T_base_sensor, "") : entry + ": absent\n";
+      out +=
+          s ? entry + ":\n" + rig::yaml_matrix4_rows(s->T_base_sensor, "") : entry + ": absent\n";
       continue;
     }
     const rig::Sensor* s = rig::find_sensor(rig, name);
@@ -245,8 +246,8 @@ std::vector<Plan> make_plans(const CalibrateOptions& o, const io::Session& s,
     }
     p.options = fmt::format(
         "camera {} lidar {} bayer {} board {} {} roi {} corner_sigma {} max_dt {}", lo.camera,
-        lo.lidar, io::to_string(lo.bayer),
-        lo.board_width_m.value_or(0), lo.board_height_m.value_or(0),
+        lo.lidar, io::to_string(lo.bayer), lo.board_width_m.value_or(0),
+        lo.board_height_m.value_or(0),
         lo.roi ? fmt::format("{} {}", fmt::join(lo.roi->first, ","), fmt::join(lo.roi->second, ","))
                : "none",
         lo.corner_sigma_px, lo.max_dt_s);

@@ -21,8 +21,8 @@ HashedInput hash_input(const std::string& role, const fs::path& path) {
     throw Error(fmt::format("{}: no such file or folder", path.string()));
   std::vector<fs::path> files;
   // Folders behind links are followed (a recording's data/ may live on another disk).
-  for (const fs::directory_entry& e : fs::recursive_directory_iterator(
-           path, fs::directory_options::follow_directory_symlink)) {
+  for (const fs::directory_entry& e :
+       fs::recursive_directory_iterator(path, fs::directory_options::follow_directory_symlink)) {
     if (e.is_regular_file()) files.push_back(fs::relative(e.path(), path));
   }
   std::sort(files.begin(), files.end());

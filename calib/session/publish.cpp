@@ -74,7 +74,8 @@ PublishResult publish(const fs::path& calibration, const std::vector<fs::path>& 
   std::vector<std::string> refused;
   for (const fs::path& seq : sequences) {
     if (!fs::is_directory(seq))
-      throw Error(fmt::format("{}: not a folder (a sequence folder, <place>/<seq>/)", seq.string()));
+      throw Error(
+          fmt::format("{}: not a folder (a sequence folder, <place>/<seq>/)", seq.string()));
     // File by file: one holding this calibration is left as it is, one holding another (or a
     // file rigcal did not publish) is replaced only when forced.
     Published p;

@@ -352,12 +352,11 @@ TEST_F(Session, TheCacheRerunsWhatChanged) {
   prior.replace(prior.find("[1.0, 0.0, 0.0, -0.05]", prior.find("gnss:")), 22,
                 "[1.0, 0.0, 0.0, -0.06]");
   io::write_file_atomic(dir_ / "prior.yaml", prior);
-  const CliRun rig_changed = rigcal_cli(
-      fmt::format("calibrate {} --out {} --rig {}", session.string(), out.string(),
-                  (dir_ / "prior.yaml").string()),
-      dir_);
-  EXPECT_NE(rig_changed.out.find("== time_sync: ok (cached"), std::string::npos)
-      << rig_changed.out;
+  const CliRun rig_changed =
+      rigcal_cli(fmt::format("calibrate {} --out {} --rig {}", session.string(), out.string(),
+                             (dir_ / "prior.yaml").string()),
+                 dir_);
+  EXPECT_NE(rig_changed.out.find("== time_sync: ok (cached"), std::string::npos) << rig_changed.out;
   EXPECT_NE(rig_changed.out.find("== hand_eye: ok\n"), std::string::npos) << rig_changed.out;
   // An earlier calibration in the folder is removed when this run publishes nothing.
   io::write_file_atomic(out / "calib.yaml", slurp(kPrior));
@@ -392,6 +391,16 @@ TEST_F(Session, DetectionsAreReusedOnlyOnTheSameImages) {
   const CliRun moved = rigcal_cli(args, dir_);
   ASSERT_EQ(moved.status, 0) << moved.err;
   EXPECT_EQ(moved.out.find("corners.vnl)"), std::string::npos) << moved.out;
+  // A prior rig without cam_r: the step adds it, the run goes on.
+  std::string prior = slurp(kPrior);
+  const size_t from = prior.find("cam_r:"), to = prior.find("lidar:");
+  io::write_file_atomic(dir_ / "no_cam_r.yaml", prior.erase(from, to - from));
+  const CliRun added =
+      rigcal_cli(fmt::format("calibrate {} --out {} --rig {} --only cameras", session.string(),
+                             out.string(), (dir_ / "no_cam_r.yaml").string()),
+                 dir_);
+  EXPECT_EQ(added.status, 0) << added.err;
+  EXPECT_NE(added.out.find("== cameras: ok"), std::string::npos) << added.out;
 }
 
 // --only and --from, and a step the data do not determine (exit 3), on the motion recording.
@@ -455,6 +464,16 @@ TEST(Publish, RefusesAnUnknownCalibrationAndReplacesWithForce) {
   EXPECT_EQ(r.sequences[0].state, "replaced");
   EXPECT_EQ(session::published_hash(dir / "seq" / "vbr_calib.yaml"), r.sha256);
   EXPECT_THROW(session::publish(kPrior, {dir / "absent"}, {}), Error);
+  // File by file: more formats later add only the new files; a foreign export is refused.
+  session::PublishOptions kalibr;
+  kalibr.formats = {rig::ExportFormat::vbr, rig::ExportFormat::kalibr};
+  const session::PublishResult more = session::publish(kPrior, {dir / "seq"}, kalibr);
+  ASSERT_EQ(more.sequences[0].files.size(), 1u);
+  EXPECT_EQ(more.sequences[0].files[0].filename(), "camchain-imucam.yaml");
+  fs::create_directories(dir / "seq2");
+  std::ofstream(dir / "seq2" / "camchain-imucam.yaml") << "cam0: {}\n";
+  EXPECT_THROW(session::publish(kPrior, {dir / "seq2"}, kalibr), Error);
+  EXPECT_FALSE(fs::exists(dir / "seq2" / "vbr_calib.yaml"));
   fs::remove_all(dir);
 }
 
