@@ -86,8 +86,9 @@ void add_calibrate(CLI::App& app) {
       "LiDAR with the clock offset (motion/ with --odometry). Writes OUT/calib.yaml once,\n"
       "atomically, with rigcal.steps (inputs and their sha256, tool version, sigmas, residuals),\n"
       "and OUT/reports/<step>/. A rerun reuses each step whose inputs, rig entries and options\n"
-      "are unchanged (OUT/cache/). Exit 0 published; 2 a step failed on bad input; 3 a step is\n"
-      "undetermined by the data: the other steps' results are kept, nothing is published.");
+      "are unchanged (OUT/cache/). Exit 0 every step that ran is ok (published when all ran);\n"
+      "2 a step failed on bad input; 3 a step is undetermined by the data: the other steps'\n"
+      "results are kept, nothing is published (an earlier OUT/calib.yaml is removed).");
   cmd->add_option("session", o->run.session, "the session folder, or a single recording")
       ->required();
   cmd->add_option("--out", o->out, "output folder")->required();
