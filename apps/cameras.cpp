@@ -46,6 +46,11 @@ void run(const Options& o) {
   camera::StepInputs in;
   in.target = o.target;
   in.images = images(o);
+  // --rig and --out may name one file: the rig updated in place (atomically).
+  std::vector<std::pair<std::string, std::filesystem::path>> inputs{{"--target", o.target}};
+  for (const auto& files : in.images.files)
+    for (const std::string& f : files) inputs.emplace_back("an image", f);
+  io::refuse_outputs_over_inputs({{o.out, ""}}, inputs);  // before the work, not after
   if (!o.rig.empty()) in.rig = rig::read_rig_file(o.rig);
   in.corners_cache = std::filesystem::path(o.report) / "corners.vnl";
   const report::StepResult r = camera::calibrate_cameras(in, so, console_progress());

@@ -54,6 +54,8 @@ void run(const Options& o) {
   if (in.lidar.empty() || in.gnss.empty())
     throw Error(
         "give --lidar and --gnss, or a --session whose session.yaml names odometry and gnss");
+  io::refuse_outputs_over_inputs(
+      {{o.out, ""}}, {{"--lidar", in.lidar}, {"--gnss", in.gnss}});  // --rig may be --out
   if (!o.rig.empty()) in.rig = rig::read_rig_file(o.rig);
   const report::StepResult r = hand_eye::estimate_extrinsic(in, so, console_progress());
   finish_step(r, o.out, o.report);

@@ -60,6 +60,11 @@ void run(Options o) {
   in.notes.clear();
   in.target = o.target;
   in.rig_source = o.rig;
+  // --rig and --out may name one file: the rig updated in place (atomically).
+  std::vector<std::pair<std::string, std::filesystem::path>> inputs{{"--target", o.target}};
+  for (size_t k = 0; k < in.images.size(); ++k)
+    inputs.emplace_back("an image", in.images[k]), inputs.emplace_back("a scan", in.scans[k]);
+  io::refuse_outputs_over_inputs({{o.out, ""}}, inputs);  // before the work, not after
   const report::StepResult r = lidar_camera::calibrate_lidar_camera(in, o.step, console_progress());
   finish_step(r, o.out, o.report);
   if (!o.out.empty())

@@ -38,6 +38,7 @@ void add_rig_convert(CLI::App& parent) {
     const rig::Rig r = rig::read_rig_file(o->file);
     const std::vector<io::OutputFile> files =
         rig::export_files(r, format, o->out, rig::ExportOptions{o->imu});
+    io::refuse_outputs_over_inputs(files, {{"the calibration", o->file}});
     io::write_files_atomic(files);
     for (const io::OutputFile& f : files) fmt::print("wrote {} ({})\n", f.path.string(), o->to);
     if (format == rig::ExportFormat::vbr) {

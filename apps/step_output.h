@@ -33,13 +33,20 @@ inline report::Progress console_progress() {
   };
 }
 
-// Prints the summary and notes; writes the report into `report_dir` (when given) and, when the
+// Refuses any output that is one of the step's inputs (the rig it updates may be written in
+// place: that is not among them). Prints the summary and notes;
+// writes the report into `report_dir` (when given) and, when the
 // step is ok, the rig into `out` (when given). Undetermined: the report is written, the reason
 // and the remedy go to stderr, and the command exits 3 with `out` not written.
 inline void finish_step(const report::StepResult& r, const std::string& out,
                         const std::string& report_dir) {
   std::vector<io::OutputFile> files;
   if (!report_dir.empty()) files = report::report_files_in(r, report_dir);
+  std::vector<std::pair<std::string, std::filesystem::path>> inputs;
+  for (const report::Input& in : r.inputs) inputs.emplace_back(in.role, in.path);
+  std::vector<io::OutputFile> all = files;
+  if (!out.empty()) all.push_back({out, ""});
+  io::refuse_outputs_over_inputs(all, inputs);
   if (r.status != report::StepStatus::ok) {
     io::write_files_atomic(files);
     for (const std::string& line : r.summary) fmt::print("{}\n", line);

@@ -21,7 +21,9 @@ void add_target_print(CLI::App& target) {
   cmd->add_option("--out", *out, "output PDF")->required();
   cmd->callback([file, out] {
     const camera::Target t = io::read_target_file(*file);
-    io::write_file_atomic(*out, io::target_pdf(t));
+    const std::vector<io::OutputFile> files{{*out, io::target_pdf(t)}};
+    io::refuse_outputs_over_inputs(files, {{"the target", *file}});
+    io::write_files_atomic(files);
     const camera::Outline o = camera::outline(t);
     fmt::print("wrote {}: {} on a {:.1f} x {:.1f} mm board\n", *out, t.name, 1000 * o.width(),
                1000 * o.height());

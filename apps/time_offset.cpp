@@ -79,6 +79,9 @@ void run(const Options& o) {
   const time_sync::TimeSyncOptions topt = sync_options(o);
   in.reference.read = read_options(o.reference_format, o.reference_columns, "reference");
   in.other.read = read_options(o.other_format, o.other_columns, "other");
+  io::refuse_outputs_over_inputs(
+      {{o.out, ""}},
+      {{"--reference", in.reference.path}, {"--other", in.other.path}});  // --rig may be --out
   if (!o.rig.empty()) in.rig = rig::read_rig_file(o.rig);  // read first: a bad rig fails fast
 
   const report::StepResult r = time_sync::estimate_clock(in, topt, console_progress());

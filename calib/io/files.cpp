@@ -90,4 +90,23 @@ void write_file_atomic(const fs::path& path, const std::string& content) {
   write_files_atomic({{path, content}});
 }
 
+void refuse_outputs_over_inputs(const std::vector<OutputFile>& outputs,
+                                const std::vector<std::pair<std::string, fs::path>>& inputs) {
+  for (const OutputFile& out : outputs) {
+    for (const auto& [what, in] : inputs) {
+      if (in.empty()) continue;
+      std::error_code ec;
+      const bool same = fs::exists(out.path, ec) && fs::exists(in, ec)
+                            ? fs::equivalent(out.path, in, ec)
+                            : fs::weakly_canonical(out.path, ec) == fs::weakly_canonical(in, ec);
+      if (same) {
+        throw Error(
+            fmt::format("{}: is an input ({}); the output would destroy it: choose "
+                        "another output",
+                        out.path.string(), what));
+      }
+    }
+  }
+}
+
 }  // namespace rigcal::io

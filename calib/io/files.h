@@ -20,4 +20,10 @@ struct OutputFile {
 void write_files_atomic(const std::vector<OutputFile>& files);
 void write_file_atomic(const std::filesystem::path& path, const std::string& content);
 
+// Throws rigcal::Error when an output is one of the inputs (the same file, links resolved): a
+// command never writes over what it reads. `inputs` holds (what, path) pairs for the message.
+void refuse_outputs_over_inputs(
+    const std::vector<OutputFile>& outputs,
+    const std::vector<std::pair<std::string, std::filesystem::path>>& inputs);
+
 }  // namespace rigcal::io

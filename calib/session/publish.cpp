@@ -106,6 +106,7 @@ PublishResult publish(const fs::path& calibration, const std::vector<fs::path>& 
     throw Error(fmt::format("not replacing a different calibration without --force: {}",
                             fmt::join(refused, "; ")));
   }
+  io::refuse_outputs_over_inputs(files, {{"the calibration", calibration}});
   io::write_files_atomic(files);
   return out;
 }

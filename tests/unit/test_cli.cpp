@@ -7,6 +7,7 @@
 #include <GeographicLib/LocalCartesian.hpp>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
@@ -365,6 +366,56 @@ TEST_F(Cli, CamerasOnASimulatedRawBayerSession) {
                 (dir_ / "d.yaml").string() + " --report " + (dir_ / "d").string())
                 .status,
             2);
+}
+
+// No command writes over what it reads (links resolved), and the IMU inputs that crashed
+// time-offset are bad input: exit 2, one line, nothing written or destroyed.
+TEST_F(Cli, OutputsNeverOverwriteInputsAndEmptyStreamsAreBadInput) {
+  const fs::path r = write("r.yaml", slurp(kSample));
+  fs::create_symlink(r, dir_ / "link.yaml");
+  const fs::path t =
+      write("t.yaml", slurp(RIGCAL_SOURCE_DIR "/targets/a3_checkerboard_8x5_40mm.yaml"));
+  const fs::path lidar = write("lidar.tum", "0 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1\n");
+  cv::imwrite((dir_ / "img_1.png").string(), cv::Mat(32, 32, CV_8UC1, cv::Scalar(0)));
+  const std::string image = (dir_ / "img_1.png").string();
+  write("scan_1.bin", std::string(16, '\0'));
+  const std::map<std::string, std::string> before = {{r.string(), slurp(r)},
+                                                     {t.string(), slurp(t)},
+                                                     {lidar.string(), slurp(lidar)},
+                                                     {image, slurp(image)}};
+  const std::string target = " --target " + t.string();
+  for (const std::string& cmd :
+       {"rig convert " + r.string() + " --to kalibr --out " + r.string(),
+        "rig convert " + r.string() + " --to vbr --out " + (dir_ / "link.yaml").string(),
+        "target print " + t.string() + " --out " + t.string(),
+        "hand-eye --lidar " + lidar.string() + " --gnss " + lidar.string() + " --out " +
+            lidar.string() + " --rig " + r.string(),
+        "cameras --camera cam_l=" + image + target + " --out " + image + " --report " +
+            (dir_ / "rep").string(),
+        "cameras --camera cam_l=" + image + target + " --out " + t.string() + " --report " +
+            (dir_ / "rep").string(),
+        "lidar-camera --images " + image + " --scans " + (dir_ / "scan_1.bin").string() + target +
+            " --rig " + r.string() + " --out " + t.string()}) {
+    const CliRun run_ = run(cmd);
+    EXPECT_EQ(run_.status, 2) << cmd << "\n" << run_.out << run_.err;
+    EXPECT_NE(run_.err.find("is an input"), std::string::npos) << cmd << "\n" << run_.err;
+    for (const auto& [file, text] : before) EXPECT_EQ(slurp(file), text) << cmd << ": " << file;
+  }
+  // An IMU folder with its header and no samples; a one-pose trajectory: either side.
+  fs::create_directories(dir_ / "empty" / "data");
+  write("empty/timestamps.txt", "");
+  write("empty/data/imu.txt", std::string("acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z\n"));
+  write("one.tum", "0 0 0 0 0 0 0 1\n");
+  const std::string sim = (dir_ / "s").string();
+  ASSERT_EQ(run("simulate --what imu --out " + sim).status, 0);
+  for (const std::string& bad : {(dir_ / "empty").string(), (dir_ / "one.tum").string()}) {
+    for (const std::string& cmd : {"time-offset --reference " + bad + " --other " + sim + "/imu",
+                                   "time-offset --reference " + sim + "/imu --other " + bad}) {
+      const CliRun run_ = run(cmd);
+      EXPECT_EQ(run_.status, 2) << cmd << "\n" << run_.err;
+      EXPECT_NE(run_.err.find("rigcal: error: " + bad), std::string::npos) << run_.err;
+    }
+  }
 }
 
 }  // namespace
