@@ -100,22 +100,37 @@ std::vector<Problem> find_problems(const Rig& rig) {
     if (s.name.empty()) add("", "a sensor needs a name");
     if (!seen.insert(s.name).second) add("", fmt::format("duplicate sensor '{}'", s.name));
     if (std::string what = check_rotation(s.T_base_sensor.R); !what.empty()) add("T_b", what);
-    if (!s.T_base_sensor.t.allFinite()) add("T_b", "translation must be finite");
-    if (!std::isfinite(s.time_offset)) add("time_offset", "must be a finite number of seconds");
+    // Physical ranges (doc/calibration-yaml.md): finite but absurd numbers would pass on to the
+    // exports as Inf and NaN.
+    if (!s.T_base_sensor.t.allFinite()) {
+      add("T_b", "translation must be finite");
+    } else if (s.T_base_sensor.t.cwiseAbs().maxCoeff() > kMaxTranslationM) {
+      add("T_b", fmt::format("translation {} m: a rig's sensors lie within {} m of each other",
+                             s.T_base_sensor.t.cwiseAbs().maxCoeff(), kMaxTranslationM));
+    }
+    if (!std::isfinite(s.time_offset)) {
+      add("time_offset", "must be a finite number of seconds");
+    } else if (std::abs(s.time_offset) > kMaxTimeOffsetS) {
+      add("time_offset", fmt::format("{} s is beyond {} s (even GPS against UNIX time is 3.2e8 s)",
+                                     s.time_offset, kMaxTimeOffsetS));
+    }
     if (s.time_drift_ppm && !(std::abs(*s.time_drift_ppm) < 1e4)) {
       add("time_drift_ppm",
           fmt::format("must be finite and below 1e4 ppm, got {}", *s.time_drift_ppm));
     }
-    if (s.update_rate && !(*s.update_rate > 0)) {
-      add("update_rate", fmt::format("must be > 0 Hz, got {}", *s.update_rate));
+    if (s.update_rate && !(*s.update_rate > 0 && *s.update_rate <= kMaxRateHz)) {
+      add("update_rate",
+          fmt::format("must be > 0 and at most {} Hz, got {}", kMaxRateHz, *s.update_rate));
     }
     if (s.type == SensorType::camera) {
       const CameraModel& c = s.camera;
-      if (!(c.fx > 0) || !(c.fy > 0)) {
-        add("intrinsics",
-            fmt::format("focal lengths fx, fy must be > 0, got fx = {}, fy = {}", c.fx, c.fy));
+      if (!(c.fx > 0 && c.fx <= kMaxPixels) || !(c.fy > 0 && c.fy <= kMaxPixels)) {
+        add("intrinsics", fmt::format("focal lengths fx, fy must be > 0 and at most {} px, got "
+                                      "fx = {}, fy = {}",
+                                      kMaxPixels, c.fx, c.fy));
       }
-      if (!std::isfinite(c.cx) || !std::isfinite(c.cy)) add("intrinsics", "cx, cy must be finite");
+      if (!(std::abs(c.cx) <= kMaxPixels) || !(std::abs(c.cy) <= kMaxPixels))
+        add("intrinsics", fmt::format("cx, cy must be finite, within {} px", kMaxPixels));
       if (!valid_coefficient_count(c.distortion_model, c.distortion_coeffs.size())) {
         add("distortion_coeffs",
             fmt::format("{} takes {} coefficients, got {}", to_string(c.distortion_model),
@@ -126,7 +141,15 @@ std::vector<Problem> find_problems(const Rig& rig) {
                         c.distortion_coeffs.size()));
       }
       for (double k : c.distortion_coeffs) {
-        if (!std::isfinite(k)) add("distortion_coeffs", "coefficients must be finite");
+        if (!(std::abs(k) <= kMaxDistortion)) {
+          add("distortion_coeffs",
+              fmt::format("coefficients must be finite, within +-{}, got {}", kMaxDistortion, k));
+          break;
+        }
+      }
+      if (c.width > kMaxImageSide || c.height > kMaxImageSide) {
+        add("resolution",
+            fmt::format("at most {} px a side, got [{}, {}]", kMaxImageSide, c.width, c.height));
       }
       if (c.width <= 0 || c.height <= 0) {
         add("resolution",
@@ -140,7 +163,8 @@ std::vector<Problem> find_problems(const Rig& rig) {
           {"accelerometer_noise_density", &s.imu.accelerometer_noise_density},
           {"accelerometer_random_walk", &s.imu.accelerometer_random_walk}};
       for (const auto& [key, value] : noise) {
-        if (*value && !(**value > 0)) add(key, fmt::format("must be > 0, got {}", **value));
+        if (*value && !(**value > 0 && **value <= kMaxNoise))
+          add(key, fmt::format("must be > 0 and at most {}, got {}", kMaxNoise, **value));
       }
     }
     if (!s.attached_to.empty()) {

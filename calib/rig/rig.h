@@ -110,6 +110,16 @@ void set_clock_from(Rig& rig, std::string_view sensor, std::string_view referenc
 // problem, naming sensor and key: duplicate names, bad intrinsics, non-rotations, unknown base.
 void validate(const Rig& rig);
 
+// Physical ranges validate() holds a rig to: beyond them a number is a mistake, and the exports
+// would carry Inf and NaN (fx 1e308, a translation of 1e308 m).
+inline constexpr double kMaxTranslationM = 1e3;  // a rig's sensors lie within metres
+inline constexpr double kMaxTimeOffsetS = 1e9;   // GPS against UNIX time is 3.2e8 s
+inline constexpr double kMaxPixels = 1e6;        // focal lengths and principal point, px
+inline constexpr double kMaxDistortion = 1e3;    // each distortion coefficient
+inline constexpr int kMaxImageSide = 100000;     // px
+inline constexpr double kMaxRateHz = 1e6;
+inline constexpr double kMaxNoise = 1e3;  // IMU noise densities and random walks
+
 // Tolerance of the rotation check: max |R^T R - I| <= 1e-5 passes (a matrix printed with six
 // decimals is within it), and det R must be positive.
 inline constexpr double kRotationTolerance = 1e-5;

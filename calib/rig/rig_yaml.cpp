@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <map>
 #include <regex>
 #include <set>
@@ -146,14 +147,46 @@ SensorType infer_type(const std::string& name, const YAML::Node& node) {
   throw Error("cannot tell what kind of sensor this is; add 'sensor_type: camera|lidar|imu|gnss'");
 }
 
+// Levenshtein distance, for suggesting the key a typo meant.
+size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1])});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
 Sensor read_sensor(Reader& r, const std::string& name, const YAML::Node& node, bool vbr_style,
                    std::vector<std::string>& notes) {
   Sensor s;
   s.name = name;
   r.remember(name, node);
+  std::set<std::string> seen;
   for (auto it = node.begin(); it != node.end(); ++it) {
     const std::string key = it->first.Scalar();
+    // yaml-cpp keeps both entries of a repeated key and node[key] finds the first: refused.
+    if (!seen.insert(key).second)
+      r.fail(it->first, name + "." + key, "given twice in this sensor (which one is meant?)");
     r.remember(name + "." + key, it->second);
+    // A key one or two letters from a known one is a typo, not an extra key kept as it is
+    // (time_offsett would otherwise leave the offset at 0 without a word).
+    if (!kKnownKeys.count(key)) {
+      for (const std::string& known : kKnownKeys) {
+        if (edit_distance(key, known) <= 2) {
+          r.fail(it->first, name + "." + key,
+                 fmt::format("unknown key; did you mean '{}'? (other unknown keys are kept as "
+                             "they are)",
+                             known));
+        }
+      }
+    }
   }
   auto key_of = [&](std::string_view k) { return fmt::format("{}.{}", name, k); };
   auto require = [&](const char* k) {

@@ -102,7 +102,7 @@ TEST_F(Cli, BadInputIsOneLineNamingFileLineAndKeyWithExitTwo) {
   const CliRun r = run("rig validate " + bad.string());
   EXPECT_EQ(r.status, 2);
   EXPECT_EQ(r.err, "rigcal: error: " + bad.string() +
-                       ":2: key 'cam_l.intrinsics': focal lengths fx, fy must be > 0, got fx = 0, "
+                       ":2: key 'cam_l.intrinsics': focal lengths fx, fy must be > 0 and at most 1000000 px, got fx = 0, "
                        "fy = 100\n");
   EXPECT_TRUE(r.out.empty());
   const CliRun missing = run("rig show " + (dir_ / "nope.yaml").string());

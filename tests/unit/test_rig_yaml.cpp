@@ -226,10 +226,12 @@ TEST(RigYaml, EveryValidationErrorNamesFileLineAndKey) {
        camera_with("T_b", "  T_b: [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, -1, 0], [0, 0, 0, 1]]"),
        "rig.yaml:7: key 'cam_l.T_b': rotation has determinant < 0 (a reflection, not a rotation)"},
       {"negative focal length", camera_with("intrinsics", "  intrinsics: [-1000, 1000, 640, 360]"),
-       "rig.yaml:4: key 'cam_l.intrinsics': focal lengths fx, fy must be > 0, got fx = -1000, fy = "
+       "rig.yaml:4: key 'cam_l.intrinsics': focal lengths fx, fy must be > 0 and at most 1000000 "
+       "px, got fx = -1000, fy = "
        "1000"},
       {"zero focal length", camera_with("intrinsics", "  intrinsics: [1000, 0, 640, 360]"),
-       "rig.yaml:4: key 'cam_l.intrinsics': focal lengths fx, fy must be > 0, got fx = 1000, fy = "
+       "rig.yaml:4: key 'cam_l.intrinsics': focal lengths fx, fy must be > 0 and at most 1000000 "
+       "px, got fx = 1000, fy = "
        "0"},
       {"intrinsics count", camera_with("intrinsics", "  intrinsics: [1000, 1000, 640]"),
        "rig.yaml:4: key 'cam_l.intrinsics': expected 4 numbers [fx, fy, cx, cy], got 3"},
@@ -285,6 +287,31 @@ TEST(RigYaml, EveryValidationErrorNamesFileLineAndKey) {
            "  intrinsics: [1, 1, 1, 1]"),
        "rig.yaml:11: key 'lidar.intrinsics': 'intrinsics' belongs to cameras, but this sensor is a "
        "lidar"},
+      // Finite but absurd numbers, repeated keys and typos of known keys.
+      {"fx 1e308", camera_with("intrinsics", "  intrinsics: [1e308, 1000, 640, 360]"),
+       "rig.yaml:4: key 'cam_l.intrinsics': focal lengths fx, fy must be > 0 and at most 1000000 "
+       "px, got fx = 1e+308, fy = 1000"},
+      {"distortion 1e300",
+       camera_with("distortion_coeffs", "  distortion_coeffs: [1e300, 0, 0, 0]"),
+       "rig.yaml:5: key 'cam_l.distortion_coeffs': coefficients must be finite, within +-1000, got "
+       "1e+300"},
+      {"a translation of 1e308 m",
+       camera_with("T_b", "  T_b: [[1, 0, 0, 1e308], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]"),
+       "rig.yaml:7: key 'cam_l.T_b': translation 1e+308 m: a rig's sensors lie within 1000 m of "
+       "each other"},
+      {"time_offset 1e308",
+       camera_with("lidar",
+                   "lidar: {T_b: [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]], time_offset: 1e308}"),
+       "rig.yaml:8: key 'lidar.time_offset': 1e+308 s is beyond 1000000000 s (even GPS against "
+       "UNIX time is 3.2e8 s)"},
+      {"a key given twice",
+       camera_with("resolution", "  resolution: [1280, 720]\n  resolution: [640, 480]"),
+       "rig.yaml:7: key 'cam_l.resolution': given twice in this sensor (which one is meant?)"},
+      {"a typo of a known key",
+       camera_with("lidar",
+                   "lidar: {T_b: [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]], time_offsett: 0.1}"),
+       "rig.yaml:8: key 'lidar.time_offsett': unknown key; did you mean 'time_offset'? (other "
+       "unknown keys are kept as they are)"},
   };
   for (const BadCase& c : cases) {
     SCOPED_TRACE(c.name);
