@@ -178,8 +178,10 @@ void add_bench(CLI::App& app) {
   cmd->add_option("--est-dir", o->est_dir, "leaderboard: folder of <method>/<seq>_es.txt");
   cmd->add_option("--methods", o->methods, "leaderboard: comma-separated method folders");
   cmd->add_option("--ate-max", o->ate_max, "leaderboard: ATE threshold for the rank, m")
+      ->check(finite_number(true))
       ->capture_default_str();
   cmd->add_option("--rpe-max", o->rpe_max, "leaderboard: RPE threshold for the rank, %")
+      ->check(finite_number(true))
       ->capture_default_str();
   cmd->callback([o] {
     if (!o->gt_dir.empty()) return run_leaderboard(*o);

@@ -2,6 +2,8 @@
 // The `rigcal` command line: each subcommand lives in its own file and registers itself here.
 // Subcommands talk to people; the library computes, calib/io and calib/rig read and write.
 #include <CLI/CLI.hpp>
+#include <cmath>
+#include <string>
 
 namespace rigcal::cli {
 
@@ -10,6 +12,20 @@ namespace rigcal::cli {
 struct Exit {
   int status;
 };
+
+// Option checks for numbers that must be finite and > 0 (`strict`) or >= 0: CLI11's own ranges
+// let NaN through.
+inline CLI::Validator finite_number(bool strict) {
+  return CLI::Validator(
+      [strict](std::string& text) -> std::string {
+        double v = 0;
+        if (CLI::detail::lexical_cast(text, v) && std::isfinite(v) && (strict ? v > 0 : v >= 0))
+          return {};
+        return std::string("expected a finite number ") + (strict ? "> 0" : ">= 0") + ", got '" +
+               text + "'";
+      },
+      strict ? "POSITIVE" : "NON-NEGATIVE");
+}
 
 // `rigcal rig validate|show|convert`
 void add_rig_validate(CLI::App& rig);

@@ -115,20 +115,26 @@ void add_hand_eye(CLI::App& app) {
   cmd->add_option("--stride", o->stride_s,
                   "seconds between the starts of consecutive pairs (0: end to end); overlapping "
                   "pairs are not counted as independent in the covariance")
+      ->check(finite_number(false))
       ->capture_default_str();
   cmd->add_option(
          "--gnss-smoothing", o->gnss_smoothing_s,
          "each GNSS/INS pose from a local quadratic fit over the fixes within +- this many "
          "seconds (at least 5 of them; 0: the fixes as they are)")
+      ->check(finite_number(false))
       ->capture_default_str();
   cmd->add_option("--min-rotation", o->min_rotation_deg, "pairs rotating less are dropped (deg)")
+      ->check(finite_number(false))
       ->capture_default_str();
   cmd->add_option("--rotation-sigma", o->rotation_sigma_deg, "per-pair rotation noise (deg)")
+      ->check(finite_number(true))
       ->capture_default_str();
   cmd->add_option("--translation-sigma", o->translation_sigma_m, "per-pair translation noise (m)")
+      ->check(finite_number(true))
       ->capture_default_str();
   cmd->add_option("--max-sigma", o->max_sigma_m,
                   "a translation direction with a larger 1-sigma is not estimated (m)")
+      ->check(finite_number(true))
       ->capture_default_str();
   cmd->callback([o] { run(*o); });
 }

@@ -116,6 +116,8 @@ std::string_view to_string(TrajectoryFormat format) {
 
 TrajectoryFile parse_trajectory(std::string_view text, std::string_view file_name,
                                 const TrajectoryReadOptions& options) {
+  // A UTF-8 byte-order mark (editors on Windows write one) is not part of the first line.
+  if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
   std::string headers;
   const std::vector<TextLine> lines = data_lines(text, &headers);
   if (lines.empty()) fail_at(file_name, 0, "", "no poses: the file is empty or all comments");
@@ -237,7 +239,9 @@ TrajectoryFile parse_trajectory(std::string_view text, std::string_view file_nam
     if (!options.kitti_times.empty()) {
       const std::string times_text = read_text_file(options.kitti_times);
       const std::string times_name = options.kitti_times.string();
-      const std::vector<TextLine> times = data_lines(times_text, nullptr);
+      std::string_view times_view = times_text;
+      if (times_view.starts_with("\xEF\xBB\xBF")) times_view.remove_prefix(3);
+      const std::vector<TextLine> times = data_lines(times_view, nullptr);
       if (times.size() != traj.size()) {
         fail_at(times_name, 0, "",
                 fmt::format("{} times for {} poses of {}", times.size(), traj.size(), file_name));

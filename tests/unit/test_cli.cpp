@@ -102,7 +102,8 @@ TEST_F(Cli, BadInputIsOneLineNamingFileLineAndKeyWithExitTwo) {
   const CliRun r = run("rig validate " + bad.string());
   EXPECT_EQ(r.status, 2);
   EXPECT_EQ(r.err, "rigcal: error: " + bad.string() +
-                       ":2: key 'cam_l.intrinsics': focal lengths fx, fy must be > 0 and at most 1000000 px, got fx = 0, "
+                       ":2: key 'cam_l.intrinsics': focal lengths fx, fy must be > 0 and at most "
+                       "1000000 px, got fx = 0, "
                        "fy = 100\n");
   EXPECT_TRUE(r.out.empty());
   const CliRun missing = run("rig show " + (dir_ / "nope.yaml").string());
@@ -416,6 +417,26 @@ TEST_F(Cli, OutputsNeverOverwriteInputsAndEmptyStreamsAreBadInput) {
       EXPECT_NE(run_.err.find("rigcal: error: " + bad), std::string::npos) << run_.err;
     }
   }
+}
+
+// Options that must be finite and positive say so (NaN included), exit 2; a UTF-8 byte-order
+// mark before a TUM file's first line is read past.
+TEST_F(Cli, NumericOptionsAreCheckedAndABomIsReadPast) {
+  const fs::path tum = write("a.tum",
+                             "\xEF\xBB\xBF"
+                             "0 0 0 0 0 0 0 1\n1 1 0 0 0 0 0 1\n2 2 1 0 0 0 0 1\n3 0 2 1 0 0 0 1\n");
+  CliRun r = run("bench --gt " + tum.string() + " --est " + tum.string());
+  EXPECT_EQ(r.status, 0) << r.err;
+  for (const char* opt : {"--rotation-sigma 0", "--translation-sigma nan", "--stride -1",
+                          "--max-sigma inf", "--min-rotation -2"}) {
+    r = run("hand-eye --lidar " + tum.string() + " --gnss " + tum.string() + " " +
+            std::string(opt));
+    EXPECT_EQ(r.status, 2) << opt << ": " << r.err;
+    EXPECT_NE(r.err.find("expected a finite number"), std::string::npos) << opt << ": " << r.err;
+  }
+  r = run("bench --gt-dir " + dir_.string() + " --est-dir " + dir_.string() +
+          " --methods a --ate-max nan");
+  EXPECT_EQ(r.status, 2) << r.err;
 }
 
 }  // namespace
