@@ -422,9 +422,10 @@ TEST_F(Cli, OutputsNeverOverwriteInputsAndEmptyStreamsAreBadInput) {
 // Options that must be finite and positive say so (NaN included), exit 2; a UTF-8 byte-order
 // mark before a TUM file's first line is read past.
 TEST_F(Cli, NumericOptionsAreCheckedAndABomIsReadPast) {
-  const fs::path tum = write("a.tum",
-                             "\xEF\xBB\xBF"
-                             "0 0 0 0 0 0 0 1\n1 1 0 0 0 0 0 1\n2 2 1 0 0 0 0 1\n3 0 2 1 0 0 0 1\n");
+  const fs::path tum =
+      write("a.tum",
+            "\xEF\xBB\xBF"
+            "0 0 0 0 0 0 0 1\n1 1 0 0 0 0 0 1\n2 2 1 0 0 0 0 1\n3 0 2 1 0 0 0 1\n");
   CliRun r = run("bench --gt " + tum.string() + " --est " + tum.string());
   EXPECT_EQ(r.status, 0) << r.err;
   for (const char* opt : {"--rotation-sigma 0", "--translation-sigma nan", "--stride -1",
@@ -437,6 +438,14 @@ TEST_F(Cli, NumericOptionsAreCheckedAndABomIsReadPast) {
   r = run("bench --gt-dir " + dir_.string() + " --est-dir " + dir_.string() +
           " --methods a --ate-max nan");
   EXPECT_EQ(r.status, 2) << r.err;
+  // A leaderboard where every run failed (the estimate missing) scores nothing: exit 2.
+  fs::create_directories(dir_ / "gt");
+  fs::create_directories(dir_ / "est" / "a");
+  fs::copy_file(tum, dir_ / "gt" / "seq_gt.txt");
+  r = run("bench --gt-dir " + (dir_ / "gt").string() + " --est-dir " + (dir_ / "est").string() +
+          " --methods a");
+  EXPECT_EQ(r.status, 2) << r.out << r.err;
+  EXPECT_NE(r.err.find("no run could be scored"), std::string::npos) << r.err;
 }
 
 }  // namespace
