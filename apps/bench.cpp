@@ -130,10 +130,7 @@ void run_leaderboard(const Options& o) {
     bench::write_leaderboard_report(board, o.report);
     fmt::print("report: {}/leaderboard.{{md,csv,json}} and cumulative curves\n", o.report);
   }
-  size_t scored = 0;
-  for (const bench::MethodRow& row : board.rows)
-    for (const bench::Entry& e : row.entries) scored += e.ok;
-  if (scored == 0) {
+  if (bench::scored_entries(board) == 0) {
     fmt::print(stderr,
                "rigcal: error: no run could be scored (every estimate missing or failed)\n");
     throw Exit{2};

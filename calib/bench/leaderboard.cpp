@@ -89,4 +89,11 @@ Leaderboard build_leaderboard(const LeaderboardInput& in, const EvalOptions& opt
   return board;
 }
 
+size_t scored_entries(const Leaderboard& board) {
+  size_t n = 0;
+  for (const MethodRow& row : board.rows)
+    for (const Entry& e : row.entries) n += e.ok;
+  return n;
+}
+
 }  // namespace rigcal::bench

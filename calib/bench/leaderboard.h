@@ -45,6 +45,9 @@ struct Leaderboard {
   std::string ate_definition, rpe_definition;
 };
 
+// How many entries of the board were scored (not missing, not failed).
+size_t scored_entries(const Leaderboard& board);
+
 // progress: one line per evaluated pair, for the command line.
 Leaderboard build_leaderboard(const LeaderboardInput& input, const EvalOptions& options,
                               const std::function<void(std::string_view)>& progress = {});
