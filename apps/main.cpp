@@ -7,7 +7,14 @@
 
 #include "cli.h"
 #include "rigcal/core/error.h"
+#include "rigcal/core/text.h"
 #include "rigcal/core/version.h"
+
+namespace {
+// A message quotes what it was given (a key, a value, a path): on stderr it stays one line of
+// valid text, whatever bytes the input held.
+std::string one_line(const char* message) { return rigcal::printable(message, 2000); }
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -43,15 +50,15 @@ int main(int argc, char** argv) {
   } catch (const CLI::Success& e) {
     return app.exit(e);  // --help, --version
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "rigcal: %s (see rigcal --help)\n", e.what());
+    std::fprintf(stderr, "rigcal: %s (see rigcal --help)\n", one_line(e.what()).c_str());
     return 2;
   } catch (const rigcal::cli::Exit& e) {
     return e.status;
   } catch (const rigcal::Error& e) {
-    std::fprintf(stderr, "rigcal: error: %s\n", e.what());
+    std::fprintf(stderr, "rigcal: error: %s\n", one_line(e.what()).c_str());
     return 2;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "rigcal: internal error: %s\n", e.what());
+    std::fprintf(stderr, "rigcal: internal error: %s\n", one_line(e.what()).c_str());
     return 1;
   }
   return 0;

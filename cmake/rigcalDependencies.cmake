@@ -17,6 +17,9 @@ if(NOT TARGET PkgConfig::CAIRO)
 endif()
 find_dependency(TBB)
 find_dependency(apriltag)
+# The image reader decodes JPEG itself and checks PNG chunk CRCs (calib/io/image_io.cpp).
+find_dependency(JPEG)
+find_dependency(ZLIB)
 
 # mrcal 2.2 ships no CMake or pkg-config file: one header folder and -lmrcal.
 if(NOT TARGET rigcal_mrcal)

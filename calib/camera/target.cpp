@@ -27,7 +27,16 @@ void validate(const Target& t) {
       bad("tag_spacing", "must be in (0, 2] (gap / tag size)");
     if (t.cols * t.rows > 587) bad("cols/rows", "tag36h11 has 587 tags");
   }
-  if (!(t.thickness >= 0)) bad("thickness", "must be >= 0 m");
+  if (!(t.thickness >= 0) || t.thickness > kMaxBoardThickness)
+    bad("thickness", fmt::format("must be in [0, {}] m", kMaxBoardThickness));
+  if (t.cols > kMaxTargetCorners || t.rows > kMaxTargetCorners)
+    bad("cols/rows", fmt::format("{} x {}: at most {} a side", t.cols, t.rows, kMaxTargetCorners));
+  if (!std::isfinite(t.margin)) bad("margin", "must be a finite number of m");
+  const Outline o = outline(t);
+  if (!(o.width() <= kMaxTargetSide && o.height() <= kMaxTargetSide)) {
+    bad("size", fmt::format("the board would be {:.4g} x {:.4g} m; at most {} m a side", o.width(),
+                            o.height(), kMaxTargetSide));
+  }
 }
 
 std::vector<Eigen::Vector3d> object_points(const Target& t) {

@@ -26,6 +26,12 @@ struct Target {
   double thickness = 0.005;  // of the physical board, m
 };
 
+// What a target may be: boards people print and hold (the largest in use are about 2 m), with
+// room to spare; a target over these is a typo or a hostile file, refused before any drawing.
+inline constexpr int kMaxTargetCorners = 200;      // cols and rows, each
+inline constexpr double kMaxTargetSide = 10.0;     // m, the board's outline, margin included
+inline constexpr double kMaxBoardThickness = 0.2;  // m
+
 // Throws rigcal::Error naming the bad field.
 void validate(const Target& target);
 

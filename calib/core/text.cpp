@@ -30,16 +30,55 @@ std::string_view trim(std::string_view s) {
   return s;
 }
 
+namespace {
+// Length of the valid UTF-8 sequence starting at s[i] (2..4), or 0.
+size_t utf8_sequence(std::string_view s, size_t i) {
+  const auto c = static_cast<unsigned char>(s[i]);
+  const size_t n = c >= 0xC2 && c <= 0xDF   ? 2
+                   : c >= 0xE0 && c <= 0xEF ? 3
+                   : c >= 0xF0 && c <= 0xF4 ? 4
+                                            : 0;
+  if (n == 0 || i + n > s.size()) return 0;
+  for (size_t k = 1; k < n; ++k)
+    if ((static_cast<unsigned char>(s[i + k]) & 0xC0) != 0x80) return 0;
+  const auto c1 = static_cast<unsigned char>(s[i + 1]);
+  if ((c == 0xE0 && c1 < 0xA0) || (c == 0xED && c1 > 0x9F) || (c == 0xF0 && c1 < 0x90) ||
+      (c == 0xF4 && c1 > 0x8F))
+    return 0;  // overlong, surrogate or beyond U+10FFFF
+  return n;
+}
+}  // namespace
+
+std::string printable(std::string_view text, size_t max_chars) {
+  std::string out;
+  size_t chars = 0;
+  for (size_t i = 0; i < text.size(); ++chars) {
+    if (chars == max_chars) return out + "...";
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c >= 0x20 && c < 0x7F) {
+      out += static_cast<char>(c);
+      ++i;
+    } else if (const size_t n = c >= 0x80 ? utf8_sequence(text, i) : 0; n > 0) {
+      out.append(text.substr(i, n));
+      i += n;
+    } else {
+      out += fmt::format("\\x{:02X}", c);
+      ++i;
+    }
+  }
+  return out;
+}
+
 double parse_double(std::string_view text, std::string_view what) {
   std::string_view s = trim(text);
   if (!s.empty() && s.front() == '+') s.remove_prefix(1);
   double value = 0.0;
   const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
   if (s.empty() || ec == std::errc::invalid_argument || end != s.data() + s.size()) {
-    throw Error(fmt::format("{}: expected a number, got '{}'", what, text));
+    throw Error(fmt::format("{}: expected a number, got '{}'", what, printable(text)));
   }
   if (ec == std::errc::result_out_of_range || !std::isfinite(value)) {
-    throw Error(fmt::format("{}: expected a finite number, got '{}'", what, text));
+    throw Error(fmt::format("{}: expected a finite number, got '{}'", what, printable(text)));
   }
   return value;
 }
@@ -50,7 +89,7 @@ long long parse_int(std::string_view text, std::string_view what) {
   long long value = 0;
   const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
   if (s.empty() || ec != std::errc() || end != s.data() + s.size()) {
-    throw Error(fmt::format("{}: expected an integer, got '{}'", what, text));
+    throw Error(fmt::format("{}: expected an integer, got '{}'", what, printable(text)));
   }
   return value;
 }

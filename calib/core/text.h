@@ -22,6 +22,11 @@ std::string format_double(double value, bool keep_point = false);
 
 std::string_view trim(std::string_view s);
 
+// `text` made safe to quote in a one-line message: bytes that are not printable ASCII or part of
+// valid UTF-8 (control characters, a line break, stray bytes) written as \xNN, and anything past
+// `max_chars` cut with "...". A message never ends in a raw invalid byte or spans lines.
+std::string printable(std::string_view text, size_t max_chars = 80);
+
 struct TextLine {
   std::string_view text;  // trimmed
   int number;             // 1-based

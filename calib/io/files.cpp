@@ -14,7 +14,7 @@ namespace rigcal::io {
 
 namespace fs = std::filesystem;
 
-std::string read_text_file(const fs::path& path) {
+std::string read_text_file(const fs::path& path, size_t max_bytes) {
   std::error_code ec;
   if (fs::is_directory(path, ec)) {
     throw Error(fmt::format("{}: is a folder, expected a file", path.string()));
@@ -25,6 +25,10 @@ std::string read_text_file(const fs::path& path) {
   }
   // One allocation of the file's size (large trajectories are hundreds of MB).
   const std::streamoff size = in.tellg();
+  if (size > 0 && static_cast<size_t>(size) > max_bytes) {
+    throw Error(fmt::format("{}: {} bytes, over the limit of {} bytes for this kind of file",
+                            path.string(), size, max_bytes));
+  }
   std::string text(size > 0 ? static_cast<size_t>(size) : 0, '\0');
   in.seekg(0);
   in.read(text.data(), static_cast<std::streamsize>(text.size()));

@@ -2,6 +2,7 @@
 // Whole-file reading and all-or-nothing writing. Every output of rigcal goes through
 // write_files_atomic: each file is written to a temporary name beside its destination, flushed,
 // and renamed only when all of them were written, so a failed run leaves no half-written output.
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <utility>
@@ -9,8 +10,9 @@
 
 namespace rigcal::io {
 
-// Throws rigcal::Error naming the path when the file cannot be read.
-std::string read_text_file(const std::filesystem::path& path);
+// Throws rigcal::Error naming the path when the file cannot be read, or when it is larger than
+// `max_bytes` (a documented limit of the format being read: kMaxYamlBytes for YAML).
+std::string read_text_file(const std::filesystem::path& path, size_t max_bytes = SIZE_MAX);
 
 struct OutputFile {
   std::filesystem::path path;

@@ -14,9 +14,16 @@ enum class Bayer { none, rggb, bggr, grbg, gbrg };
 Bayer bayer_from_string(std::string_view name);
 std::string_view to_string(Bayer bayer);
 
+// What read_gray accepts: a side of 16 to 32768 px and at most 100 Mpx, checked from the file's
+// header (PNG, JPEG, PNM, BMP) before anything is decoded.
+inline constexpr long long kMinImageSide = 16;
+inline constexpr long long kMaxImageSide = 32768;
+inline constexpr long long kMaxImagePixels = 100'000'000;
+
 // 8-bit gray. 16-bit images are scaled by 1/256; colour images converted with OpenCV's BGR
 // weights; a Bayer image (one channel) demosaiced (edge-aware) to gray. Throws rigcal::Error
-// naming the file when it cannot be read, or when a Bayer pattern is given for a colour image.
+// naming the file when it cannot be read, is damaged (a PNG chunk's CRC, a JPEG's data), is outside
+// the sizes above, or when a Bayer pattern is given for a colour image. Nothing reaches stderr.
 cv::Mat read_gray(const std::filesystem::path& path, Bayer bayer = Bayer::none);
 
 }  // namespace rigcal::io

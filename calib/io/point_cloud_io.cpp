@@ -16,6 +16,12 @@
 namespace rigcal::io {
 namespace {
 
+// A point record is a few dozen bytes (the Ouster driver's: 48); a header claiming more is damaged.
+constexpr size_t kMaxRecordBytes = 1 << 16;
+// PCL counts points in 32 bits; what a file may hold is then bounded by its size.
+constexpr long long kMaxPcdPoints = 4'294'967'295LL;
+constexpr size_t kMaxPcdFields = 1024;
+
 void keep(std::vector<Eigen::Vector3d>& out, double x, double y, double z) {
   if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) return;
   if (x == 0 && y == 0 && z == 0) return;
@@ -85,6 +91,9 @@ std::vector<Field> vbr_fields(const std::filesystem::path& bin, size_t& point_st
               f.at("datatype").get<int>(), f.value("count", size_t{1})};
       if (datatype_size(x.datatype) == 0)
         throw Error(fmt::format("field '{}': datatype {} unknown", x.name, x.datatype));
+      if (x.offset > kMaxRecordBytes || x.count > kMaxRecordBytes)
+        throw Error(fmt::format("field '{}': offset {} or count {} past any record", x.name,
+                                x.offset, x.count));
       extent = std::max(extent, x.offset + datatype_size(x.datatype) * x.count);
       fields.push_back(x);
     }
@@ -95,7 +104,15 @@ std::vector<Field> vbr_fields(const std::filesystem::path& bin, size_t& point_st
   }
   // The record's size: "point_step" where given, else the fields' extent padded to 16 bytes
   // (the Ouster driver's and PCL's aligned point types: 48 bytes for x..range).
-  point_step = j.contains("point_step") ? j["point_step"].get<size_t>() : (extent + 15) / 16 * 16;
+  try {
+    point_step = j.contains("point_step") ? j["point_step"].get<size_t>() : (extent + 15) / 16 * 16;
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(fmt::format("{}: point_step not read ({})", meta.string(), e.what()));
+  }
+  if (point_step < extent || point_step > kMaxRecordBytes) {
+    throw Error(fmt::format("{}: point_step {} does not hold the fields ({} bytes)", meta.string(),
+                            point_step, extent));
+  }
   return fields;
 }
 
@@ -176,7 +193,7 @@ std::vector<Eigen::Vector3d> read_pcd(const std::filesystem::path& path) {
   const std::string name = path.string();
   std::vector<std::string> fields, types;
   std::vector<int> sizes, counts;
-  size_t points = 0;
+  long long points = -1, width = -1, height = -1;
   std::string data_kind, line;
   int line_no = 0;
   while (data_kind.empty() && std::getline(in, line)) {
@@ -184,15 +201,46 @@ std::vector<Eigen::Vector3d> read_pcd(const std::filesystem::path& path) {
     const std::vector<std::string_view> f = split_fields(line);
     if (f.empty() || f[0].front() == '#') continue;
     const std::string key(f[0]);
+    const std::string where = fmt::format("{}:{}: {}", name, line_no, key);
     std::vector<std::string> rest(f.begin() + 1, f.end());
+    auto count = [&](std::string_view text, long long low, long long high) {
+      const long long v = parse_int(text, where);
+      if (v < low || v > high) {
+        throw Error(fmt::format("{}: {} is outside {}..{}", where, v, low, high));
+      }
+      return v;
+    };
+    auto one = [&]() -> const std::string& {
+      if (rest.size() != 1) throw Error(fmt::format("{}: expected one value", where));
+      return rest[0];
+    };
+    if (rest.size() > kMaxPcdFields) {
+      throw Error(
+          fmt::format("{}: {} values (at most {} fields)", where, rest.size(), kMaxPcdFields));
+    }
     if (key == "FIELDS") fields = rest;
     if (key == "TYPE") types = rest;
     if (key == "SIZE" || key == "COUNT") {
       std::vector<int>& v = key == "SIZE" ? sizes : counts;
-      for (const std::string& s : rest) v.push_back(static_cast<int>(parse_int(s, key)));
+      v.clear();
+      for (const std::string& x : rest) {
+        const long long n = key == "SIZE" ? count(x, 1, 8) : count(x, 1, 1 << 16);
+        if (key == "SIZE" && n != 1 && n != 2 && n != 4 && n != 8)
+          throw Error(fmt::format("{}: {} bytes (1, 2, 4 or 8)", where, n));
+        v.push_back(static_cast<int>(n));
+      }
     }
-    if (key == "POINTS") points = static_cast<size_t>(parse_int(rest.at(0), "POINTS"));
-    if (key == "DATA") data_kind = rest.empty() ? "" : rest[0];
+    if (key == "WIDTH") width = count(one(), 0, kMaxPcdPoints);
+    if (key == "HEIGHT") height = count(one(), 0, kMaxPcdPoints);
+    if (key == "POINTS") points = count(one(), 0, kMaxPcdPoints);
+    if (key == "DATA") data_kind = rest.empty() ? "(none)" : rest[0];
+  }
+  if (data_kind.empty()) throw Error(fmt::format("{}: PCD header without a DATA line", name));
+  if (points < 0 && width >= 0 && height >= 0) points = width * height;
+  if (points < 0) throw Error(fmt::format("{}: PCD header without POINTS", name));
+  if (width >= 0 && height >= 0 && width * height != points) {
+    throw Error(fmt::format("{}: PCD header says WIDTH x HEIGHT = {} x {} but POINTS {}", name,
+                            width, height, points));
   }
   if (counts.empty()) counts.assign(fields.size(), 1);
   if (fields.empty() || sizes.size() != fields.size() || types.size() != fields.size() ||
@@ -217,9 +265,13 @@ std::vector<Eigen::Vector3d> read_pcd(const std::filesystem::path& path) {
       throw Error(fmt::format("{}: PCD field {} is not float32 or float64", name, fields[i]));
     }
   }
+  // What the file holds after its header bounds every allocation, whatever POINTS claims.
+  const auto header_end = static_cast<long long>(in.tellg());
+  const auto remaining = static_cast<long long>(std::filesystem::file_size(path)) - header_end;
   std::vector<Eigen::Vector3d> out;
-  out.reserve(points);
   if (data_kind == "ascii") {
+    out.reserve(static_cast<size_t>(std::min(points, remaining / (2LL * columns) + 1)));
+    long long rows = 0;
     while (std::getline(in, line)) {
       ++line_no;
       const std::vector<std::string_view> f = split_fields(line);
@@ -228,13 +280,27 @@ std::vector<Eigen::Vector3d> read_pcd(const std::filesystem::path& path) {
         throw Error(
             fmt::format("{}:{}: {} values, the header says {}", name, line_no, f.size(), columns));
       }
+      if (++rows > points) {
+        throw Error(
+            fmt::format("{}:{}: more points than the header's POINTS {}", name, line_no, points));
+      }
       auto val = [&](int i) {
-        return f[column[i]] == "nan" ? NAN : parse_double(f[column[i]], fields[i]);
+        return f[column[i]] == "nan"
+                   ? NAN
+                   : parse_double(f[column[i]], fmt::format("{}:{}: {}", name, line_no, fields[i]));
       };
       keep(out, val(ix), val(iy), val(iz));
     }
+    if (rows != points) {
+      throw Error(fmt::format("{}: {} points, the header's POINTS says {}", name, rows, points));
+    }
   } else if (data_kind == "binary") {
-    std::string buf(static_cast<size_t>(stride) * points, '\0');
+    if (remaining < 0 || points > remaining / stride || points * stride != remaining) {
+      throw Error(
+          fmt::format("{}: binary PCD of {} data bytes does not hold its {} points of {} bytes",
+                      name, std::max(remaining, 0LL), points, stride));
+    }
+    std::string buf(static_cast<size_t>(stride * points), '\0');
     in.read(buf.data(), static_cast<std::streamsize>(buf.size()));
     if (static_cast<size_t>(in.gcount()) != buf.size()) {
       throw Error(fmt::format("{}: binary PCD shorter than its {} points", name, points));
@@ -243,7 +309,9 @@ std::vector<Eigen::Vector3d> read_pcd(const std::filesystem::path& path) {
       const char* p = buf.data() + k * stride + offset[i];
       return sizes[i] == 4 ? load<float>(p) : load<double>(p);
     };
-    for (size_t k = 0; k < points; ++k) keep(out, val(k, ix), val(k, iy), val(k, iz));
+    out.reserve(static_cast<size_t>(points));
+    for (size_t k = 0; k < static_cast<size_t>(points); ++k)
+      keep(out, val(k, ix), val(k, iy), val(k, iz));
   } else {
     throw Error(
         fmt::format("{}: PCD DATA '{}' not read (ascii or binary; convert with "

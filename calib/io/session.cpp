@@ -30,7 +30,7 @@ const char* default_folder(std::string_view purpose) {
 }
 
 void read_session_yaml(const fs::path& file, Session& s) {
-  const YAML::Node root = load_yaml(read_text_file(file), file.string());
+  const YAML::Node root = load_yaml(read_text_file(file, kMaxYamlBytes), file.string());
   if (root.IsNull()) return;
   if (!root.IsMap()) fail_at(file.string(), yaml_line(root), "", "expected a map of keys to paths");
   const std::pair<const char*, fs::path*> keys[] = {

@@ -139,7 +139,7 @@ void apply_sim_config(std::string_view text, std::string_view file, sim::SimConf
 }
 
 void read_sim_config(const std::filesystem::path& path, sim::SimConfig& config) {
-  apply_sim_config(read_text_file(path), path.string(), config);
+  apply_sim_config(read_text_file(path, kMaxYamlBytes), path.string(), config);
 }
 
 }  // namespace rigcal::io

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <set>
 
 #include "rigcal/core/error.h"
@@ -23,19 +24,33 @@ camera::Target parse_target_yaml(std::string_view text, std::string_view file) {
   };
   auto number = [&](const char* key) {
     const YAML::Node n = get(key);
+    double v = NAN;
     try {
-      return n.as<double>();
+      v = n.as<double>();
     } catch (const YAML::Exception&) {
-      fail_at(file, line(n), key, fmt::format("expected a number, got '{}'", n.Scalar()));
     }
+    if (!std::isfinite(v)) {
+      fail_at(file, line(n), key,
+              fmt::format("expected a finite number, got '{}'", printable(n.Scalar())));
+    }
+    return v;
   };
   auto integer = [&](const char* key) {
     const double v = number(key);
     if (v != std::floor(v)) fail_at(file, line(root[key]), key, "expected a whole number");
+    if (v < 1 || v > camera::kMaxTargetCorners) {
+      fail_at(file, line(root[key]), key,
+              fmt::format("{} is outside 1..{}", v, camera::kMaxTargetCorners));
+    }
     return static_cast<int>(v);
   };
+  auto scalar = [&](const char* key) {
+    const YAML::Node n = get(key);
+    if (!n.IsScalar()) fail_at(file, line(n), key, "expected a text value");
+    return n.Scalar();
+  };
   camera::Target t;
-  const std::string type = get("target_type").as<std::string>();
+  const std::string type = scalar("target_type");
   std::set<std::string> known = {"target_type", "name", "margin", "thickness"};
   if (type == "checkerboard") {
     t.type = camera::TargetType::checkerboard;
@@ -56,18 +71,23 @@ camera::Target parse_target_yaml(std::string_view text, std::string_view file) {
     known.insert({"tagCols", "tagRows", "tagSize", "tagSpacing", "tagFamily", "codeOffset"});
   } else {
     fail_at(file, line(root["target_type"]), "target_type",
-            fmt::format("unknown target type '{}'; expected checkerboard or aprilgrid", type));
+            fmt::format("unknown target type '{}'; expected checkerboard or aprilgrid",
+                        printable(type)));
   }
   for (auto it = root.begin(); it != root.end(); ++it) {
     if (!known.count(it->first.Scalar())) {
-      fail_at(file, line(it->first), it->first.Scalar(), "unknown key for this target type");
+      fail_at(file, line(it->first), printable(it->first.Scalar()),
+              "unknown key for this target type");
     }
   }
   if (root["name"])
-    t.name = root["name"].as<std::string>();
+    t.name = scalar("name");
   else
     t.name = std::filesystem::path(std::string(file)).stem().string();
-  if (root["margin"]) t.margin = number("margin");
+  if (root["margin"]) {
+    t.margin = number("margin");
+    if (t.margin < 0) fail_at(file, line(root["margin"]), "margin", "must be >= 0 m");
+  }
   if (root["thickness"]) t.thickness = number("thickness");
   try {
     camera::validate(t);
@@ -78,7 +98,7 @@ camera::Target parse_target_yaml(std::string_view text, std::string_view file) {
 }
 
 camera::Target read_target_file(const std::filesystem::path& path) {
-  return parse_target_yaml(read_text_file(path), path.string());
+  return parse_target_yaml(read_text_file(path, kMaxYamlBytes), path.string());
 }
 
 std::string target_to_yaml(const camera::Target& t) {

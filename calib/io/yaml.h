@@ -2,11 +2,20 @@
 // Loading YAML text with errors that name the file and line (every YAML reader of rigcal).
 #include <yaml-cpp/yaml.h>
 
+#include <cstddef>
 #include <string_view>
 
 namespace rigcal::io {
 
-// Throws rigcal::Error "FILE:LINE: YAML syntax error: ..." on malformed text.
+// What a YAML input of rigcal (calibration, target, simulator config, session) may be: a
+// calibration with its provenance is tens of kB, so these bound a hostile file's time and
+// memory (a 1 MiB file loads in well under a second), not a real one.
+inline constexpr size_t kMaxYamlBytes = 1 << 20;
+// Nodes after expanding anchors and aliases (a "billion laughs" file is a few lines).
+inline constexpr size_t kMaxYamlNodes = 1'000'000;
+
+// Throws rigcal::Error "FILE:LINE: YAML syntax error: ..." on malformed text, and when the text or
+// its expansion is over the limits above.
 YAML::Node load_yaml(std::string_view text, std::string_view file_name);
 // 1-based line of a node, 0 when unknown.
 int yaml_line(const YAML::Node& node);

@@ -508,7 +508,7 @@ Rig parse_rig_yaml(std::string_view text, std::string_view file_name) {
 }
 
 Rig read_rig_file(const std::filesystem::path& path) {
-  return parse_rig_yaml(io::read_text_file(path), path.string());
+  return parse_rig_yaml(io::read_text_file(path, io::kMaxYamlBytes), path.string());
 }
 
 std::string rig_to_yaml(const Rig& rig) {

@@ -1,0 +1,229 @@
+// Hostile and damaged inputs: every reader answers with one rigcal::Error naming the file, within
+// documented limits, before allocating what a header claims, and without anything on stderr.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+#include <zlib.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <string>
+
+#include "fixtures.h"
+#include "rigcal/camera/target.h"
+#include "rigcal/core/error.h"
+#include "rigcal/core/text.h"
+#include "rigcal/io/image_io.h"
+#include "rigcal/io/point_cloud_io.h"
+#include "rigcal/io/target_yaml.h"
+#include "rigcal/io/yaml.h"
+#include "rigcal/rig/rig_yaml.h"
+
+namespace rigcal::io {
+namespace {
+
+namespace fs = std::filesystem;
+
+class InputLimits : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("rigcal_limits_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path write(const std::string& name, const std::string& bytes) {
+    std::ofstream(dir_ / name, std::ios::binary) << bytes;
+    return dir_ / name;
+  }
+  // The message of the rigcal::Error `f` throws; "" (a test failure) when it throws nothing.
+  template <typename F>
+  static std::string error_of(F&& f) {
+    try {
+      f();
+    } catch (const Error& e) {
+      return e.what();
+    }
+    ADD_FAILURE() << "no rigcal::Error";
+    return "";
+  }
+  fs::path dir_;
+};
+
+std::string be32(uint32_t v) { return {char(v >> 24), char(v >> 16), char(v >> 8), char(v)}; }
+std::string png_chunk(const std::string& type, const std::string& data) {
+  const std::string body = type + data;
+  const auto crc = static_cast<uint32_t>(
+      crc32(0, reinterpret_cast<const Bytef*>(body.data()), static_cast<uInt>(body.size())));
+  return be32(static_cast<uint32_t>(data.size())) + body + be32(crc);
+}
+// A PNG whose header claims width x height, with valid CRCs and no pixel data.
+std::string png_claiming(uint32_t width, uint32_t height) {
+  std::string ihdr = be32(width) + be32(height) + std::string("\x08\x00\x00\x00\x00", 5);
+  return std::string("\x89PNG\r\n\x1a\n", 8) + png_chunk("IHDR", ihdr) + png_chunk("IEND", "");
+}
+std::string encoded(const std::string& ext, const cv::Mat& image) {
+  std::vector<uchar> buffer;
+  cv::imencode(ext, image, buffer);
+  return std::string(buffer.begin(), buffer.end());
+}
+cv::Mat pattern(int rows, int cols, int type) {
+  cv::Mat m(rows, cols, type);
+  cv::randu(m, 0, 255);
+  return m;
+}
+
+TEST_F(InputLimits, ImageHeadersClaimingHugeSizesAreRefusedBeforeDecoding) {
+  for (auto [w, h] : {std::pair{20000u, 20000u}, std::pair{100000u, 100000u}}) {
+    const fs::path file = write("huge.png", png_claiming(w, h));
+    const auto start = std::chrono::steady_clock::now();
+    const std::string what = error_of([&] { read_gray(file); });
+    EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::milliseconds(200));
+    EXPECT_EQ(what, fmt::format("{}: {} x {} px is larger than rigcal reads (at most 32768 px a "
+                                "side and 100 Mpx)",
+                                file.string(), w, h));
+  }
+}
+
+TEST_F(InputLimits, TinyImagesAreRefused) {
+  const fs::path file = write("one.png", encoded(".png", cv::Mat(1, 1, CV_8U, cv::Scalar(7))));
+  EXPECT_EQ(error_of([&] { read_gray(file); }),
+            file.string() + ": 1 x 1 px is too small to hold a target (at least 16 px a side)");
+}
+
+TEST_F(InputLimits, DamagedPngIsAnErrorAndStderrStaysQuiet) {
+  const cv::Mat image = pattern(40, 60, CV_8UC1);
+  const std::string good = encoded(".png", image);
+  EXPECT_EQ(cv::norm(read_gray(write("good.png", good)), image, cv::NORM_INF), 0);
+
+  std::string flipped = good;
+  flipped[good.size() / 2] ^= 0x10;  // inside IDAT
+  const fs::path damaged = write("damaged.png", flipped);
+  ::testing::internal::CaptureStderr();
+  const std::string what = error_of([&] { read_gray(damaged); });
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
+  EXPECT_NE(what.find(damaged.string() + ": PNG chunk 'IDAT' at byte "), std::string::npos) << what;
+  EXPECT_NE(what.find("is damaged (CRC mismatch)"), std::string::npos) << what;
+
+  const fs::path cut = write("cut.png", good.substr(0, good.size() - 20));
+  EXPECT_NE(error_of([&] { read_gray(cut); }).find(cut.string() + ": PNG "), std::string::npos);
+}
+
+TEST_F(InputLimits, JpegDecodesExactlyAsOpenCvAndDamageIsAnError) {
+  // The reader decodes JPEG itself (to keep libjpeg's warnings off stderr): it must give OpenCV's
+  // pixels, colour and gray, on synthetic and real files.
+  std::vector<fs::path> files{write("c.jpg", encoded(".jpg", pattern(48, 64, CV_8UC3))),
+                              write("g.jpg", encoded(".jpg", pattern(48, 64, CV_8UC1)))};
+  if (const std::string real = testing::fixture("stereo/opencv_samples/left01.jpg"); !real.empty())
+    files.push_back(real);
+  for (const fs::path& f : files) {
+    cv::Mat expected = cv::imread(f.string(), cv::IMREAD_UNCHANGED);
+    if (expected.channels() == 3) cv::cvtColor(expected, expected, cv::COLOR_BGR2GRAY);
+    const cv::Mat mine = read_gray(f);
+    ASSERT_EQ(mine.size(), expected.size()) << f;
+    EXPECT_EQ(cv::norm(mine, expected, cv::NORM_INF), 0) << f;
+  }
+  const std::string good = encoded(".jpg", pattern(64, 64, CV_8UC1));
+  const fs::path cut = write("cut.jpg", good.substr(0, good.size() / 2));
+  ::testing::internal::CaptureStderr();
+  const std::string what = error_of([&] { read_gray(cut); });
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
+  EXPECT_EQ(what.rfind(cut.string() + ": the JPEG is damaged (", 0), 0u) << what;
+}
+
+TEST_F(InputLimits, PcdPointCountsAreCheckedAgainstTheData) {
+  const std::string head =
+      "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH {0}\nHEIGHT 1\n"
+      "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS {0}\nDATA {1}\n";
+  const std::string two_points = "1 2 3\n4 5 6\n";
+  struct Case {
+    std::string points, kind, data, message;
+  };
+  const std::string binary_two(24, '\x01');
+  const std::vector<Case> cases{
+      {"4000000000", "binary", binary_two,
+       "binary PCD of 24 data bytes does not hold its 4000000000 points of 12 bytes"},
+      {"3", "binary", binary_two, "binary PCD of 24 data bytes does not hold its 3 points"},
+      {"1", "binary", binary_two, "binary PCD of 24 data bytes does not hold its 1 points"},
+      {"4000000000", "ascii", two_points, "2 points, the header's POINTS says 4000000000"},
+      {"1", "ascii", two_points, ":12: more points than the header's POINTS 1"},
+      {"-5", "ascii", two_points, ":6: WIDTH: -5 is outside 0..4294967295"},
+      {"x", "ascii", two_points, ":6: WIDTH: expected an integer, got 'x'"},
+  };
+  for (const Case& c : cases) {
+    const fs::path file =
+        write("c.pcd", fmt::format(fmt::runtime(head), c.points, c.kind) + c.data);
+    const std::string what = error_of([&] { read_point_cloud(file); });
+    EXPECT_EQ(what.rfind(file.string(), 0), 0u) << what;
+    EXPECT_NE(what.find(c.message), std::string::npos) << what << "\nexpected: " << c.message;
+  }
+  const fs::path ok = write("ok.pcd", fmt::format(fmt::runtime(head), 2, "ascii") + two_points);
+  EXPECT_EQ(read_point_cloud(ok).size(), 2u);
+}
+
+TEST_F(InputLimits, YamlSizeAndAliasExpansionAreBounded) {
+  const std::string big(kMaxYamlBytes + 1, '#');
+  const fs::path file = write("big.yaml", big);
+  EXPECT_EQ(error_of([&] { rig::read_rig_file(file); }),
+            fmt::format("{}: {} bytes, over the limit of {} bytes for this kind of file",
+                        file.string(), big.size(), kMaxYamlBytes));
+  EXPECT_NE(error_of([&] { load_yaml(big, "x.yaml"); }).find("x.yaml: "), std::string::npos);
+
+  // "Billion laughs": nine levels of ten aliases expand to 10^9 nodes from 500 bytes.
+  std::string bomb = "a0: &a0 [x, x, x, x, x, x, x, x, x, x]\n";
+  for (int i = 1; i < 9; ++i) {
+    bomb += fmt::format("a{}: &a{} [", i, i);
+    for (int k = 0; k < 10; ++k) bomb += fmt::format("{}*a{}", k ? ", " : "", i - 1);
+    bomb += "]\n";
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const std::string what = error_of([&] { load_yaml(bomb, "bomb.yaml"); });
+  EXPECT_EQ(what.rfind("bomb.yaml:", 0), 0u) << what;
+  EXPECT_NE(what.find(": more than 1000000 YAML nodes once anchors and aliases are expanded"),
+            std::string::npos)
+      << what;
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(2));
+}
+
+TEST_F(InputLimits, TargetsOutsideWhatPeoplePrintAreRefused) {
+  const std::string board =
+      "target_type: checkerboard\ntargetCols: {}\ntargetRows: 5\nrowSpacingMeters: {}\n"
+      "colSpacingMeters: {}\n{}";
+  auto message = [&](const std::string& cols, const std::string& square, const std::string& extra) {
+    return error_of([&] {
+      parse_target_yaml(fmt::format(fmt::runtime(board), cols, square, square, extra), "t.yaml");
+    });
+  };
+  EXPECT_EQ(message("5000", "0.01", ""), "t.yaml:2: key 'targetCols': 5000 is outside 1..200");
+  EXPECT_EQ(message("1e8", "0.01", ""), "t.yaml:2: key 'targetCols': 100000000 is outside 1..200");
+  EXPECT_EQ(
+      message("8", "1e300", ""),
+      "t.yaml: target 't': size: the board would be 1.1e+301 x 8e+300 m; at most 10 m a side");
+  EXPECT_EQ(message("8", ".nan", ""),
+            "t.yaml:4: key 'rowSpacingMeters': expected a finite number, got '.nan'");
+  EXPECT_EQ(message("8", "0.04", "margin: -1\n"), "t.yaml:6: key 'margin': must be >= 0 m");
+  EXPECT_EQ(message("8", "0.04", "thickness: 3\n"),
+            "t.yaml: target 't': thickness: must be in [0, 0.2] m");
+  EXPECT_EQ(message("8", "0.04", "name: [a, b]\n"), "t.yaml:6: key 'name': expected a text value");
+  EXPECT_NO_THROW(parse_target_yaml(fmt::format(fmt::runtime(board), 8, 0.04, 0.04, ""), "t.yaml"));
+}
+
+TEST(Printable, InvalidBytesAndLineBreaksAreEscapedAndLongTextCut) {
+  EXPECT_EQ(printable("caf\xC3\xA9"), "caf\xC3\xA9");  // valid UTF-8 kept
+  EXPECT_EQ(printable("a\xFF"), "a\\xFF");
+  EXPECT_EQ(printable("a\xC3"), "a\\xC3");                  // a sequence cut at the end
+  EXPECT_EQ(printable("\xED\xA0\x80"), "\\xED\\xA0\\x80");  // a surrogate
+  EXPECT_EQ(printable("one\ntwo\r"), "one\\x0Atwo\\x0D");
+  EXPECT_EQ(printable(std::string(100, 'x'), 10), "xxxxxxxxxx...");
+  try {
+    parse_double("1.5\xFE", "gain");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "gain: expected a number, got '1.5\\xFE'");
+  }
+}
+
+}  // namespace
+}  // namespace rigcal::io
