@@ -72,8 +72,13 @@ void run_pair(const Options& o) {
   io::TrajectoryFile gt = io::read_trajectory(o.gt, read_options(o, o.gt_format, o.gt_times));
   io::TrajectoryFile est = io::read_trajectory(o.est, read_options(o, o.est_format, o.est_times));
   const bench::EvalOptions options = eval_options(o);
-  const bench::EvalResult r =
-      bench::evaluate(std::move(gt.trajectory), std::move(est.trajectory), options);
+  const bench::EvalResult r = [&] {
+    try {
+      return bench::evaluate(std::move(gt.trajectory), std::move(est.trajectory), options);
+    } catch (const Error& e) {
+      throw Error(fmt::format("{} against {}: {}", o.est, o.gt, e.what()));
+    }
+  }();
 
   fmt::print("rigcal bench, convention {}\n", bench::to_string(r.convention));
   fmt::print("  ground truth {} ({} poses, {}{})\n", o.gt, r.n_gt, io::to_string(gt.format),
@@ -166,10 +171,14 @@ void add_bench(CLI::App& app) {
   cmd->add_option("--association", o->association,
                   "interpolate | nearest | one_to_one | index (default: the convention's)");
   cmd->add_option("--max-diff", o->max_diff, "nearest / one_to_one: largest stamp difference, s")
+      ->check(finite_number(false))
       ->capture_default_str();
   cmd->add_option("--max-gap", o->max_gap, "interpolate: longest GT interval bridged, s")
+      ->check(finite_number(true))
       ->capture_default_str();
-  cmd->add_option("--delta", o->delta, "RPE delta of the evo-style pairs")->capture_default_str();
+  cmd->add_option("--delta", o->delta, "RPE delta of the evo-style pairs")
+      ->check(finite_number(true))
+      ->capture_default_str();
   cmd->add_option("--delta-unit", o->delta_unit, "f (frames) | m (metres of the estimate's path)")
       ->capture_default_str();
   cmd->add_flag("--all-pairs", o->all_pairs,

@@ -64,14 +64,30 @@ void run(Options o) {
                r.calibration.string(), o.out);
     return;
   }
-  std::vector<std::string> open;
-  for (const session::StepRun& s : r.steps) {
-    if (s.status != "ok") open.push_back(fmt::format("{} ({})", s.step, s.status));
-  }
-  fmt::print(stderr, "rigcal: nothing published: {}\n", fmt::join(open, ", "));
   if (!r.removed_stale.empty())
-    fmt::print(stderr, "rigcal: removed {}: an earlier run's, it does not match these inputs\n",
+    fmt::print("removed {}: an earlier run's, it does not match these inputs\n",
                r.removed_stale.string());
+  // One line on stderr, last: the first step that failed (else was undetermined) and its reason.
+  std::vector<const session::StepRun*> open;
+  for (const bool failed : {true, false}) {
+    for (const session::StepRun& s : r.steps) {
+      if (s.status != "ok" && s.status != "not run" && (s.status == "failed") == failed)
+        open.push_back(&s);
+    }
+  }
+  if (open.empty()) {
+    std::vector<std::string> not_run;
+    for (const session::StepRun& s : r.steps)
+      if (s.status == "not run") not_run.push_back(s.step);
+    fmt::print("nothing published: {} not run\n", fmt::join(not_run, ", "));
+  } else {
+    const session::StepRun& first = *open.front();
+    std::string others;
+    for (size_t k = 1; k < open.size(); ++k)
+      others += fmt::format("{}{} {}", k == 1 ? "; also " : ", ", open[k]->step, open[k]->status);
+    fmt::print(stderr, "rigcal: {}: {}: {} (nothing published{})\n",
+               first.status == "failed" ? "error" : first.status, first.step, first.reason, others);
+  }
   if (r.exit_status != 0) throw Exit{r.exit_status};
 }
 

@@ -94,6 +94,7 @@ void add_lidar_camera(CLI::App& app) {
                   "pairs by stamp on the base clock (the rig's time offsets applied)");
   cmd->add_option("--max-dt", o->step.max_dt_s,
                   "--session: an image takes the nearest scan within this many seconds")
+      ->check(finite_number(true))
       ->capture_default_str();
   cmd->add_option("--images", o->images,
                   "image glob; pairs are matched by the last number in the file names");
@@ -111,6 +112,7 @@ void add_lidar_camera(CLI::App& app) {
   cmd->add_option("--corner-sigma", o->step.corner_sigma_px,
                   "corner noise for the camera plane's covariance (px; the residuals' level "
                   "when larger)")
+      ->check(finite_number(true))
       ->capture_default_str();
   cmd->callback([o] { run(*o); });
 }

@@ -139,12 +139,15 @@ void add_time_offset(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--min-overlap", o->min_overlap,
                   "overlap a lag must leave, fraction of the shorter stream")
+      ->check(finite_number(true) & CLI::Range(0.0, 1.0))
       ->capture_default_str();
   cmd->add_option("--window", o->window_s,
                   "drift windows in seconds (0: overlap/10, at least 20 s)")
+      ->check(finite_number(false))
       ->capture_default_str();
   cmd->add_option("--min-excitation", o->min_excitation,
                   "rad/s: std of |w| below this is 'not enough excitation'")
+      ->check(finite_number(false))
       ->capture_default_str();
   cmd->add_flag("--no-three-axis", o->no_three_axis,
                 "skip the relative rotation and the three-axis refinement");

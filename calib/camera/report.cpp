@@ -76,7 +76,11 @@ std::map<std::string, Detection> parse_corners_vnl(std::string_view text, const 
         const std::vector<std::string_view> f = split_fields(ls[p]);
         if (f[1] == "-") continue;
         d.point_ids.push_back(static_cast<int>(p));
-        d.pixels.emplace_back(parse_double(f[1], "x"), parse_double(f[2], "y"));
+        try {
+          d.pixels.emplace_back(parse_double(f[1], "x"), parse_double(f[2], "y"));
+        } catch (const Error&) {
+          return {};  // a damaged cache is no cache: the images are detected again
+        }
       }
       d.found = !d.pixels.empty();
     }

@@ -1,11 +1,13 @@
 #include "rigcal/camera/step.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <tbb/parallel_for.h>
 
 #include <atomic>
 #include <map>
 #include <mutex>
+#include <set>
 
 #include "rigcal/camera/calibrate.h"
 #include "rigcal/camera/report.h"
@@ -173,11 +175,15 @@ report::StepResult calibrate_cameras(const StepInputs& in, const StepOptions& o,
   out.summary.push_back(fmt::format(
       "target '{}' found in {} of {} images{}", target.name, d.found, d.jobs.size(),
       d.from_cache ? fmt::format(" ({} from {})", d.from_cache, in.corners_cache.string()) : ""));
-  if (d.found == 0)
-    throw Error(
-        fmt::format("the target '{}' was found in none of the {} images; check the target file "
-                    "(inner corners, not squares)",
-                    target.name, d.jobs.size()));
+  if (d.found == 0) {
+    std::set<std::string> folders;
+    for (const auto& [c, f] : d.jobs)
+      folders.insert(std::filesystem::path(in.images.files[c][f]).parent_path().string());
+    throw Error(fmt::format(
+        "{}: the target '{}' ({}) was found in none of the {} images; check the target file "
+        "(inner corners, not squares)",
+        fmt::join(folders, ", "), target.name, in.target.string(), d.jobs.size()));
+  }
 
   const CalibrationResult r = calibrate(target, d.cameras, copt);
   out.rig = updated_rig(in, r);

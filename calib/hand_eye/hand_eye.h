@@ -111,6 +111,11 @@ struct Observability {
 };
 
 inline constexpr double kNearPlanarRatio = 0.1;
+// The hand-eye step refuses motion pairs whose LiDAR and GNSS/INS rotation angles differ by more
+// than this factor (median over the pairs), and calls the rotation undetermined when the second
+// rotation singular value is below kMinRotationSpread of the first (every pair about one axis).
+inline constexpr double kMinAngleRatio = 0.5;
+inline constexpr double kMinRotationSpread = 1e-3;
 
 struct ClosedForm {
   SE3 T_gnss_lidar;

@@ -7,6 +7,7 @@
 
 #include "rigcal/core/error.h"
 #include "rigcal/core/se3.h"
+#include "rigcal/core/stats.h"
 #include "rigcal/core/text.h"
 #include "rigcal/core/version.h"
 #include "rigcal/hand_eye/report.h"
@@ -174,8 +175,35 @@ report::StepResult estimate_extrinsic(const StepInputs& in, const StepOptions& o
         "3 are needed; rotate the rig about changing axes, or lower --min-rotation)",
         pairs.size(), fmt::join(spacings, " and "), po.min_rotation_deg));
   }
+  // A rigid mount turns both sensors by the same angle over the same interval: pairs whose
+  // angles disagree by far are not this rig's motion (a static or foreign odometry, or clocks
+  // apart by more than the pairs' length).
+  std::vector<double> angle_ratios;
+  for (const MotionPair& p : pairs)
+    angle_ratios.push_back(rotation_angle(p.A.R) / rotation_angle(p.B.R));
+  const double angle_ratio = median(angle_ratios);
+  if (!(angle_ratio > kMinAngleRatio && angle_ratio < 1 / kMinAngleRatio)) {
+    throw Error(fmt::format(
+        "{} against {}: the LiDAR odometry turns {:.3g} times as far as the GNSS/INS over the same "
+        "intervals (median of {} motion pairs; a rigid mount turns both alike): a static or "
+        "foreign odometry, or clocks apart by more than the pairs' length (the rig's time_offset, "
+        "--estimate-offset)",
+        in.lidar.string(), in.gnss.string(), angle_ratio, pairs.size()));
+  }
   const ClosedForm cf = closed_form(pairs, o.max_sigma_m);
   const Observability& ob = cf.observability;
+  if (ob.rotation_singular_values[1] < kMinRotationSpread * ob.rotation_singular_values[0]) {
+    const Eigen::Vector3d& n = ob.dominant_axis;
+    return undetermined(
+        out, in,
+        fmt::format("every motion pair turns about one axis, [{:.3f} {:.3f} {:.3f}] (GNSS/INS "
+                    "frame; rotation singular values {:.3g} {:.3g} {:.3g} rad): the rotation "
+                    "about it is not determined",
+                    n.x(), n.y(), n.z(), ob.rotation_singular_values[0],
+                    ob.rotation_singular_values[1], ob.rotation_singular_values[2]),
+        "record motion that turns about a second axis (pitch or roll the rig), or keep the rig's "
+        "rotation");
+  }
 
   // Directions the data do not determine: a fix along them, or the prior rig's value, or no
   // answer for them.

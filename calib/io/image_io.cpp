@@ -25,7 +25,8 @@ namespace {
 enum class ImageFormat { unknown, png, jpeg, pnm, bmp };
 struct ImageHeader {
   ImageFormat format = ImageFormat::unknown;
-  long long width = 0, height = 0;  // 0 when the header does not say (or was not read)
+  long long width = 0, height = 0;
+  bool sized = false;  // width and height read from the header
 };
 
 uint32_t big_endian32(const unsigned char* p) {
@@ -39,7 +40,7 @@ ImageHeader probe_image(std::string_view bytes) {
   const size_t n = bytes.size();
   ImageHeader h;
   if (n >= 24 && bytes.substr(0, 8) == "\x89PNG\r\n\x1a\n" && bytes.substr(12, 4) == "IHDR") {
-    return {ImageFormat::png, big_endian32(b + 16), big_endian32(b + 20)};
+    return {ImageFormat::png, big_endian32(b + 16), big_endian32(b + 20), true};
   }
   if (n >= 3 && b[0] == 0xFF && b[1] == 0xD8 && b[2] == 0xFF) {
     h.format = ImageFormat::jpeg;
@@ -54,6 +55,7 @@ ImageHeader probe_image(std::string_view bytes) {
       if (m >= 0xC0 && m <= 0xCF && m != 0xC4 && m != 0xC8 && m != 0xCC) {
         h.height = b[i + 5] << 8 | b[i + 6];
         h.width = b[i + 7] << 8 | b[i + 8];
+        h.sized = true;
         break;
       }
       if (m == 0xD8 || (m >= 0xD0 && m <= 0xD7)) {
@@ -79,7 +81,7 @@ ImageHeader probe_image(std::string_view bytes) {
       if (i >= n || !std::isdigit(b[i])) return h;
       for (; i < n && std::isdigit(b[i]) && x < (1LL << 40); ++i) x = x * 10 + (b[i] - '0');
     }
-    h.width = v[0], h.height = v[1];
+    h.width = v[0], h.height = v[1], h.sized = true;
     return h;
   }
   if (n >= 26 && b[0] == 'B' && b[1] == 'M') {
@@ -87,7 +89,7 @@ ImageHeader probe_image(std::string_view bytes) {
     std::memcpy(&w, b + 18, 4);
     std::memcpy(&ht, b + 22, 4);
     return {ImageFormat::bmp, std::abs(static_cast<long long>(w)),
-            std::abs(static_cast<long long>(ht))};
+            std::abs(static_cast<long long>(ht)), true};
   }
   return h;
 }
@@ -205,7 +207,7 @@ cv::Mat read_gray(const std::filesystem::path& path, Bayer bayer) {
   const std::string name = path.string();
   const std::string bytes = read_text_file(path);  // binary-safe
   const ImageHeader header = probe_image(bytes);
-  if (header.width > 0 || header.height > 0) check_image_size(header, name);
+  if (header.sized) check_image_size(header, name);
   cv::Mat img;
   if (header.format == ImageFormat::jpeg) {
     img = decode_jpeg(bytes, name);
@@ -220,7 +222,7 @@ cv::Mat read_gray(const std::filesystem::path& path, Bayer bayer) {
     }
   }
   if (img.empty()) throw Error(fmt::format("{}: cannot read the image", name));
-  if (header.width == 0) check_image_size({header.format, img.cols, img.rows}, name);
+  if (!header.sized) check_image_size({header.format, img.cols, img.rows, true}, name);
   if (img.depth() == CV_16U) img.convertTo(img, CV_8U, 1.0 / 256);
   if (img.depth() != CV_8U) throw Error(fmt::format("{}: expected an 8- or 16-bit image", name));
   cv::Mat gray;  // never img's buffer: demosaicing in place reads pixels it has overwritten

@@ -13,6 +13,17 @@ namespace rigcal::io {
 namespace fs = std::filesystem;
 namespace {
 
+// A gyroscope's sample beyond any sensor's range (MEMS gyros end at 35 rad/s, 2000 deg/s) is a
+// damaged row or a file in deg/s, not a motion to correlate.
+void check_gyro_range(const Eigen::Vector3d& w, std::string_view file, int line) {
+  if (w.cwiseAbs().maxCoeff() > time_sync::kMaxGyroRate) {
+    fail_at(file, line, "",
+            fmt::format("angular rate of {} rad/s, beyond any gyroscope ({} rad/s); damaged, or "
+                        "in deg/s (rigcal reads rad/s)",
+                        format_double(w.cwiseAbs().maxCoeff()), time_sync::kMaxGyroRate));
+  }
+}
+
 using Format = RateReadOptions::Format;
 using TimeUnit = RateReadOptions::TimeUnit;
 
@@ -86,6 +97,7 @@ RateFile read_table(const std::string& text, const std::string& file, const Rate
         fail_at(file, line.number, "", fmt::format("field {}: {}", cols.w[a] + 1, e.what()));
       }
     }
+    check_gyro_range(w, file, line.number);
     out.rates.rates.push_back(w);
   }
   return out;
@@ -136,6 +148,7 @@ RateFile read_vbr(const fs::path& dir) {
         fail_at(data.string(), lines[k].number, "", e.what());
       }
     }
+    check_gyro_range(v, data.string(), lines[k].number);
     out.rates.rates.push_back(v);
   }
   return out;
@@ -238,6 +251,13 @@ RateFile read_rates(const fs::path& path, const RateReadOptions& opt) {
     out.merged = time_sync::merge_equal_stamps(out.rates);
   } catch (const Error& e) {
     throw Error(fmt::format("{}: {}", path.string(), e.what()));
+  }
+  if (const size_t spikes =
+          format == Format::trajectory ? 0 : time_sync::repair_spikes(out.rates)) {
+    out.notes.push_back(fmt::format(
+        "{}: {} isolated samples far from both neighbours (rows swapped or damaged in the log) "
+        "replaced by their neighbours' mean",
+        path.filename().string(), spikes));
   }
   if (out.merged) {
     out.notes.push_back(fmt::format(

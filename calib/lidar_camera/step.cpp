@@ -101,7 +101,22 @@ report::StepResult calibrate_lidar_camera(const StepInputs& in, const StepOption
     const SE3 T = rig::T_a_b(rig, o.camera, o.lidar);
     if (!T.t.isZero()) prior = T;  // a rig with the camera placed already
   }
-  const Calibration c = calibrate(pairs, search, prior);
+  size_t in_images = 0;
+  for (const PairInput& p : pairs) in_images += p.camera.has_value();
+  const Calibration c = [&] {
+    try {
+      return calibrate(pairs, search, prior);
+    } catch (const Error& e) {
+      // Which data: the folders, and how many images showed the board (the scans' boards are
+      // searched inside calibrate).
+      const std::string images_dir =
+          std::filesystem::path(in.images.front()).parent_path().string();
+      const std::string scans_dir = std::filesystem::path(in.scans.front()).parent_path().string();
+      throw Error(fmt::format("{} and {}: {} (the target {} was found in {} of {} images)",
+                              images_dir, scans_dir, e.what(), in.target.string(), in_images,
+                              pairs.size()));
+    }
+  }();
   const Solution& s = c.solution;
 
   report::StepResult out;

@@ -3,19 +3,29 @@
 #include <fmt/format.h>
 
 #include "rigcal/core/error.h"
+#include "rigcal/io/image_io.h"
 
 namespace rigcal::sim {
 namespace {
 
 const rig::Sensor& camera_named(const rig::Rig& rig, std::string_view name, size_t fallback_index) {
-  if (const rig::Sensor* s = rig::find_sensor(rig, name); s && s->type == rig::SensorType::camera)
-    return *s;
-  const std::vector<const rig::Sensor*> cams = rig::cameras(rig);
-  if (cams.size() <= fallback_index) {
-    throw Error(fmt::format("the rig needs {} camera(s) to simulate this; it has {}",
-                            fallback_index + 1, cams.size()));
+  const rig::Sensor* camera = rig::find_sensor(rig, name);
+  if (!camera || camera->type != rig::SensorType::camera) {
+    const std::vector<const rig::Sensor*> cams = rig::cameras(rig);
+    if (cams.size() <= fallback_index) {
+      throw Error(fmt::format("the rig needs {} camera(s) to simulate this; it has {}",
+                              fallback_index + 1, cams.size()));
+    }
+    camera = cams[fallback_index];
   }
-  return *cams[fallback_index];
+  // Images rigcal could not read back are not rendered (nor their memory spent).
+  const long long width = camera->camera.width, height = camera->camera.height;
+  if (width > io::kMaxImageSide || height > io::kMaxImageSide ||
+      width * height > io::kMaxImagePixels) {
+    throw Error(fmt::format("{}: {} x {} px is larger than rigcal reads ({} Mpx); not simulated",
+                            camera->name, width, height, io::kMaxImagePixels / 1000000));
+  }
+  return *camera;
 }
 
 const rig::Sensor* imu_named(const rig::Rig& rig, std::string_view name) {

@@ -60,6 +60,23 @@ AngularRates angular_rates_from_trajectory(const Trajectory& traj) {
   return out;
 }
 
+size_t repair_spikes(AngularRates& r) {
+  const size_t n = r.rates.size();
+  if (n < 10) return 0;
+  std::vector<double> jump(n, 0.0);  // distance from the neighbours' mean
+  for (size_t k = 1; k + 1 < n; ++k)
+    jump[k] = (r.rates[k] - 0.5 * (r.rates[k - 1] + r.rates[k + 1])).norm();
+  const double typical = median(std::vector<double>(jump.begin() + 1, jump.end() - 1));
+  const double limit = kSpikeFactor * std::max(typical, 1e-6);
+  std::vector<size_t> spikes;
+  for (size_t k = 1; k + 1 < n; ++k) {
+    if (jump[k] > limit && (r.rates[k + 1] - r.rates[k - 1]).norm() < 0.25 * jump[k])
+      spikes.push_back(k);
+  }
+  for (size_t k : spikes) r.rates[k] = 0.5 * (r.rates[k - 1] + r.rates[k + 1]);
+  return spikes.size();
+}
+
 size_t merge_equal_stamps(AngularRates& r) {
   size_t merged = 0, out = 0;
   for (size_t k = 0; k < r.stamps.size();) {

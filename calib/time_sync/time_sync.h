@@ -41,6 +41,15 @@ AngularRates angular_rates_from_trajectory(const Trajectory& T_world_body);
 // Returns how many samples were merged away. Throws rigcal::Error when stamps go backwards.
 size_t merge_equal_stamps(AngularRates& rates);
 
+// Gyroscope samples beyond this (rad/s) are refused by the readers.
+inline constexpr double kMaxGyroRate = 100.0;
+// Isolated spikes: a sample further than kSpikeFactor times the series' typical step from the
+// mean of its two neighbours, while the neighbours agree with each other (within a quarter of
+// that distance), is replaced by that mean; such samples come from rows swapped or damaged in a
+// log, and a correlation would otherwise lock onto them. Returns how many were replaced.
+inline constexpr double kSpikeFactor = 20.0;
+size_t repair_spikes(AngularRates& rates);
+
 struct TimeSyncOptions {
   // Offsets searched: |offset| <= max_offset_s. Infinity: every lag with enough overlap.
   double max_offset_s = 1.0;

@@ -190,6 +190,107 @@ TEST_F(Steps, HandEyeMovesTheInsImuWithIt) {
   ASSERT_NE(find_file(u, "hand_eye.json"), nullptr);
 }
 
+// Rows swapped in an IMU log (two pairs of 12,000, far apart) shifted the offset by 2.6 ms (1-sigma
+// 0.9 ms); the isolated samples are now repaired, said in the notes, and the offset is the
+// clean log's. A sample beyond any gyroscope (1e308, or a log in deg/s) names its line.
+TEST_F(Steps, TimeSyncRepairsSwappedRowsAndRefusesImpossibleRates) {
+  const fs::path s = simulate("imu", "");
+  time_sync::StepInputs in = time_sync::streams_of_recording(s);
+  in.rig = rig::read_rig_file(kPrior);
+  const double clean = rig::sensor(time_sync::estimate_clock(in, {}).rig, "imu").time_offset;
+  const fs::path imu = s / "imu" / "data" / "imu.txt";
+  std::vector<std::string> rows;
+  {
+    std::ifstream f(imu);
+    for (std::string line; std::getline(f, line);) rows.push_back(line);
+  }
+  ASSERT_GT(rows.size(), 9002u);
+  std::swap(rows[2001], rows[9001]);
+  std::swap(rows[5001], rows[7001]);
+  auto write_rows = [&] {
+    std::ofstream f(imu);
+    for (const std::string& r : rows) f << r << "\n";
+  };
+  write_rows();
+  const report::StepResult r = time_sync::estimate_clock(in, {});
+  ASSERT_EQ(r.status, report::StepStatus::ok) << r.reason;
+  EXPECT_NEAR(rig::sensor(r.rig, "imu").time_offset, clean, 2e-5);
+  bool said = false;
+  for (const std::string& n : r.notes)
+    said |= n.find("imu: 4 isolated samples far from both neighbours") != std::string::npos;
+  EXPECT_TRUE(said) << "no note of the repaired samples";
+
+  // One row's angular rate set to 1e308 rad/s.
+  std::string& row = rows[3001];
+  for (int comma = 0, i = 0; i < static_cast<int>(row.size()); ++i) {
+    if (row[i] == ',' && ++comma == 3) {
+      row.insert(static_cast<size_t>(i) + 1, "1e308");
+      break;
+    }
+  }
+  // The field now reads "1e308-1.23...": put a comma-free value there instead.
+  const size_t start = row.find("1e308"), end = row.find(',', start);
+  row.replace(start, end - start, "1e308");
+  write_rows();
+  try {
+    time_sync::estimate_clock(in, {});
+    ADD_FAILURE() << "a 1e308 rad/s sample was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              imu.string() +
+                  ":3002: angular rate of 1e+308 rad/s, beyond any gyroscope (100 rad/s); "
+                  "damaged, or in deg/s (rigcal reads rad/s)");
+  }
+}
+
+// Degenerate motion never gets a confident answer: a static LiDAR odometry against a moving
+// GNSS/INS is refused (the two turn by different angles), and motion about one axis only leaves
+// the rotation about it undetermined (before: T_b written with "0.000 +- 0.000 deg").
+TEST_F(Steps, HandEyeRefusesStaticOdometryAndOneAxisMotion) {
+  const fs::path s = simulate("trajectories", "");
+  hand_eye::StepInputs in;
+  in.gnss = s / "trajectories" / "gnss_ins.tum";
+  in.rig = rig::read_rig_file(kPrior);
+  const Trajectory moving = io::read_trajectory(in.gnss).trajectory;
+  Trajectory still = moving;
+  for (SE3& T : still.T_world_body) T = SE3{};
+  io::write_file_atomic(dir_ / "still.tum", io::trajectory_to_tum(still));
+  in.lidar = dir_ / "still.tum";
+  try {
+    hand_eye::estimate_extrinsic(in, {});
+    ADD_FAILURE() << "a static odometry was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("still.tum against " + in.gnss.string() +
+                                         ": the LiDAR odometry turns 0 times as far as the "
+                                         "GNSS/INS"),
+              std::string::npos)
+        << e.what();
+  }
+
+  // Both sensors turning about z only (a yaw-only car), the GNSS/INS 0.3 m beside the LiDAR.
+  Trajectory lidar, gnss;
+  const SE3 T_lidar_gnss{Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.3, 0.1, 0.2)};
+  for (int k = 0; k < 3000; ++k) {
+    const double t = 0.01 * k, yaw = 0.8 * std::sin(0.7 * t) + 0.3 * std::sin(2.1 * t);
+    const SE3 T_world_lidar{Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix(),
+                            Eigen::Vector3d(2 * t, std::sin(t), 0)};
+    lidar.stamps.push_back(Time::from_seconds(t));
+    lidar.T_world_body.push_back(T_world_lidar);
+    gnss.stamps.push_back(Time::from_seconds(t));
+    gnss.T_world_body.push_back(T_world_lidar * T_lidar_gnss);
+  }
+  io::write_file_atomic(dir_ / "yaw_lidar.tum", io::trajectory_to_tum(lidar));
+  io::write_file_atomic(dir_ / "yaw_gnss.tum", io::trajectory_to_tum(gnss));
+  in.lidar = dir_ / "yaw_lidar.tum";
+  in.gnss = dir_ / "yaw_gnss.tum";
+  const report::StepResult u = hand_eye::estimate_extrinsic(in, {});
+  EXPECT_EQ(u.status, report::StepStatus::undetermined);
+  EXPECT_NE(u.reason.find("every motion pair turns about one axis, [0.000 0.000 1.000]"),
+            std::string::npos)
+      << u.reason;
+  EXPECT_TRUE(u.wrote.empty());
+}
+
 TEST(Rig, AttachedSensorsMoveRigidlyAndCyclesAreRefused) {
   rig::Rig r = rig::read_rig_file(kPrior);
   ASSERT_EQ(rig::sensor(r, "imu").attached_to, "gnss");
