@@ -8,18 +8,23 @@ namespace rigcal::io {
 
 namespace {
 // Counts nodes as a reader walking the tree would meet them (an alias once per use).
-void count_nodes(const YAML::Node& node, size_t& count, std::string_view file) {
+void count_nodes(const YAML::Node& node, size_t& count, std::string_view file, int depth = 0) {
+  if (depth > kMaxYamlDepth) {
+    fail_at(file, yaml_line(node), "",
+            fmt::format("YAML nested deeper than {} levels (or an alias inside itself)",
+                        kMaxYamlDepth));
+  }
   if (++count > kMaxYamlNodes) {
     fail_at(file, yaml_line(node), "",
             fmt::format("more than {} YAML nodes once anchors and aliases are expanded",
                         kMaxYamlNodes));
   }
   if (node.IsSequence()) {
-    for (const YAML::Node& child : node) count_nodes(child, count, file);
+    for (const YAML::Node& child : node) count_nodes(child, count, file, depth + 1);
   } else if (node.IsMap()) {
     for (auto it = node.begin(); it != node.end(); ++it) {
-      count_nodes(it->first, count, file);
-      count_nodes(it->second, count, file);
+      count_nodes(it->first, count, file, depth + 1);
+      count_nodes(it->second, count, file, depth + 1);
     }
   }
 }

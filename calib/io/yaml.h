@@ -13,6 +13,8 @@ namespace rigcal::io {
 inline constexpr size_t kMaxYamlBytes = 1 << 20;
 // Nodes after expanding anchors and aliases (a "billion laughs" file is a few lines).
 inline constexpr size_t kMaxYamlNodes = 1'000'000;
+// Levels of nesting (an alias used inside its own anchor is infinitely deep).
+inline constexpr int kMaxYamlDepth = 200;
 
 // Throws rigcal::Error "FILE:LINE: YAML syntax error: ..." on malformed text, and when the text or
 // its expansion is over the limits above.

@@ -471,6 +471,10 @@ Rig parse_rig_yaml(std::string_view text, std::string_view file_name) {
   std::set<std::string> seen;
   for (auto it = root.begin(); it != root.end(); ++it) {
     const std::string name = it->first.Scalar();
+    if (name.empty() || printable(name, name.size()) != name) {
+      r.fail(it->first, printable(name),
+             "a sensor name must be printable text (no control characters or invalid UTF-8)");
+    }
     if (!seen.insert(name).second) {
       r.fail(it->first, name,
              fmt::format("duplicate sensor '{}' (a sensor name appears twice)", name));

@@ -52,6 +52,11 @@ class InputLimits : public ::testing::Test {
   fs::path dir_;
 };
 
+std::string slurp_sample_rig() {
+  std::ifstream in(RIGCAL_SOURCE_DIR "/data/sample_rig.yaml");
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
 std::string be32(uint32_t v) { return {char(v >> 24), char(v >> 16), char(v >> 8), char(v)}; }
 std::string png_chunk(const std::string& type, const std::string& data) {
   const std::string body = type + data;
@@ -185,6 +190,22 @@ TEST_F(InputLimits, YamlSizeAndAliasExpansionAreBounded) {
             std::string::npos)
       << what;
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(2));
+
+  // An alias inside its own anchor is infinitely deep: an error, not a stack overflow.
+  EXPECT_EQ(error_of([&] { load_yaml("x: &x [*x]\n", "self.yaml"); }),
+            "self.yaml:1: YAML nested deeper than 200 levels (or an alias inside itself)");
+  // A sensor name with invalid UTF-8 is refused, its bytes quoted as \xNN.
+  const std::string rig = slurp_sample_rig();
+  const size_t at = rig.find("\nlidar:");
+  ASSERT_NE(at, std::string::npos);
+  std::string bad = rig;
+  bad.replace(at + 1, 5,
+              "li\xFF"
+              "ar");
+  const std::string name_error = error_of([&] { rig::parse_rig_yaml(bad, "r.yaml"); });
+  EXPECT_NE(name_error.find("key 'li\\xFFar': a sensor name must be printable text"),
+            std::string::npos)
+      << name_error;
 }
 
 TEST_F(InputLimits, TargetsOutsideWhatPeoplePrintAreRefused) {
