@@ -1,6 +1,8 @@
 #include "rigcal/io/files.h"
 
 #include <fmt/format.h>
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -111,6 +113,28 @@ void refuse_outputs_over_inputs(const std::vector<OutputFile>& outputs,
       }
     }
   }
+}
+
+FolderLock::FolderLock(const fs::path& folder) {
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  fd_ = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd_ < 0) {
+    throw Error(fmt::format("{}: cannot open the output folder: {}", folder.string(),
+                            std::strerror(errno)));
+  }
+  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    ::close(fd_);
+    fd_ = -1;
+    throw Error(fmt::format(
+        "{}: another rigcal run is writing this folder; wait for it to end or choose another "
+        "output folder",
+        folder.string()));
+  }
+}
+
+FolderLock::~FolderLock() {
+  if (fd_ >= 0) ::close(fd_);  // releases the lock
 }
 
 }  // namespace rigcal::io

@@ -28,4 +28,19 @@ void refuse_outputs_over_inputs(
     const std::vector<OutputFile>& outputs,
     const std::vector<std::pair<std::string, std::filesystem::path>>& inputs);
 
+// An exclusive claim on an output folder for one run (flock on the folder itself, so nothing is
+// left behind; released when the object ends, or the process does). Two runs writing the same
+// folder at once would leave a mixture of their files: the second is refused with a
+// rigcal::Error naming the folder. Creates the folder when missing.
+class FolderLock {
+ public:
+  explicit FolderLock(const std::filesystem::path& folder);
+  ~FolderLock();
+  FolderLock(const FolderLock&) = delete;
+  FolderLock& operator=(const FolderLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
+
 }  // namespace rigcal::io

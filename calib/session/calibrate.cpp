@@ -337,6 +337,7 @@ CalibrateResult calibrate(const CalibrateOptions& o, const Progress& progress) {
   if (!o.only.empty()) check_step_name(o.only);
   if (!o.from.empty() && !o.only.empty()) throw Error("give --from or --only, not both");
   if (o.out.empty()) throw Error("--out: the output folder is needed");
+  const io::FolderLock claim(o.out);
   const io::Session s = io::read_session(o.session);
   const fs::path rig_file = o.rig.empty() ? s.rig : o.rig;
   if (rig_file.empty()) {

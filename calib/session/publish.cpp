@@ -4,6 +4,8 @@
 #include <fmt/ranges.h>
 
 #include <fstream>
+#include <memory>
+#include <set>
 
 #include "rigcal/core/error.h"
 #include "rigcal/core/sha256.h"
@@ -72,10 +74,14 @@ PublishResult publish(const fs::path& calibration, const std::vector<fs::path>& 
   }
   std::vector<io::OutputFile> files;
   std::vector<std::string> refused;
+  std::vector<std::unique_ptr<io::FolderLock>> claims;  // every sequence, for the whole run
+  std::set<fs::path> claimed;
   for (const fs::path& seq : sequences) {
     if (!fs::is_directory(seq))
       throw Error(
           fmt::format("{}: not a folder (a sequence folder, <place>/<seq>/)", seq.string()));
+    if (claimed.insert(fs::canonical(seq)).second)
+      claims.push_back(std::make_unique<io::FolderLock>(seq));
     // File by file: one holding this calibration is left as it is, one holding another (or a
     // file rigcal did not publish) is replaced only when forced.
     Published p;
