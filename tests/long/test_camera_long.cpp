@@ -4,6 +4,7 @@
 // projection errors against the mrcal-style projection uncertainty (5 pixels a camera).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -67,4 +68,41 @@ TEST(CameraSimLong, ReportedSigmasAreHonestOver20Seeds) {
     // worst-direction sigma (elongated to round).
     EXPECT_GT(pz_median, 0.4);
   }
+}
+
+// The 6 x 6 AprilGrid (88 mm tags), radtan, 40 views: the bars as rates over 20 seeds.
+// The stereo rotation's 0.01 deg bar, met narrowly by seed 1 (0.0097 deg), holds in a fraction of
+// the seeds only (doc/cameras.md gives the figures this asserts).
+TEST(CameraSimLong, AprilGridBarsOver20Seeds) {
+  int focal = 0, pp = 0, baseline = 0, rot = 0, rot2 = 0;
+  double rot_max = 0;
+  std::vector<double> rots;
+  for (uint64_t seed = 1; seed <= 20; ++seed) {
+    const rigcal::camera::TruthZ t = rigcal::camera::check_aprilgrid_for_long_test(seed);
+    std::printf(
+        "AprilGrid seed %2llu: focal %.2e, principal point %.3f px, baseline %.3f mm, rotation "
+        "%.4f deg (1-sigma %.4f %.4f %.4f)\n",
+        static_cast<unsigned long long>(seed), t.focal_rel, t.principal_point_px,
+        1e3 * t.baseline_m, t.rotation_deg, t.rotation_sigma_deg[0], t.rotation_sigma_deg[1],
+        t.rotation_sigma_deg[2]);
+    focal += t.focal_rel <= 2e-4;
+    pp += t.principal_point_px <= 0.3;
+    baseline += t.baseline_m <= 0.2e-3;
+    rot += t.rotation_deg <= 0.01;
+    rot2 += t.rotation_deg <= 0.02;
+    rot_max = std::max(rot_max, t.rotation_deg);
+    rots.push_back(t.rotation_deg);
+  }
+  std::printf(
+      "AprilGrid over 20 seeds: focal <= 2e-4 in %d, principal point <= 0.3 px in %d, baseline "
+      "<= 0.2 mm in %d, rotation <= 0.01 deg in %d (<= 0.02 deg in %d; median %.4f, max %.4f "
+      "deg)\n",
+      focal, pp, baseline, rot, rot2, rigcal::median(rots), rot_max);
+  EXPECT_EQ(focal, 20);
+  EXPECT_EQ(baseline, 20);
+  // Measured: principal point 19 of 20, rotation <= 0.01 deg 10 of 20 (median 0.0102 deg),
+  // <= 0.02 deg 19 of 20 (max 0.0236). Asserted: at least 80 %, 40 % and 95 %.
+  EXPECT_GE(pp, 16);
+  EXPECT_GE(rot, 8);
+  EXPECT_GE(rot2, 19);
 }

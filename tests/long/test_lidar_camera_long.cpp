@@ -1,8 +1,8 @@
 // Issue 8, acceptance 1 over seeds: 10 simulated pairs (OS0-128 noise, clutter) per seed, 20
-// seeds: how often the bars (rotation <= 0.1 deg, translation <= 5 mm) are met (printed: the
-// rotation's 1-sigma about the optical axis is 0.05-0.11 deg with 10 boards, so 0.1 deg is not met
-// on every seed, see doc/lidar-camera.md), whether the board is found in every scan, and whether
-// the errors fall within 3 reported sigmas at least 95 % of the time. The short version is
+// seeds: how often the bars (rotation <= 0.1 deg, translation <= 5 mm) are met (the rotation's
+// 1-sigma about the optical axis is 0.05-0.11 deg with 10 boards, so 0.1 deg is not met on every
+// seed: asserted as a rate, see doc/lidar-camera.md), whether the board is found in every scan, and
+// whether the errors fall within 3 reported sigmas at least 95 % of the time. The short version is
 // LidarCameraSim.* in make test.
 #include <gtest/gtest.h>
 
@@ -43,9 +43,11 @@ TEST(LidarCameraSimLong, TwentySeeds) {
       "%d of %d; within 3 sigma: rotation %d of %d axes, translation %d of %d\n",
       found, pairs, rot_ok, runs, trans_ok, runs, cover_r, 3 * runs, cover_t, 3 * runs);
   // Asserted: the board found in every scan (the simulator's boards are fully visible), the
-  // translation and rotation sigmas honest, every translation within 5 mm.
+  // translation and rotation sigmas honest, every translation within 5 mm, and the rotation bar
+  // as the rate it is: within 0.1 deg in at least 70 % of the seeds (15 of 20 measured).
   EXPECT_EQ(found, pairs);
   EXPECT_EQ(trans_ok, runs);
+  EXPECT_GE(rot_ok, 0.7 * runs);
   EXPECT_GE(cover_t, 0.95 * 3 * runs);
   EXPECT_GE(cover_r, 0.95 * 3 * runs);
 }

@@ -5,9 +5,11 @@
 // correlation of |w| over +-1 s at 100 Hz that the VBR rig's 5 ms bound comes from (direct sums, as
 // np.correlate computes them).
 //   build/bin/rigcal_perf_time_sync
+//   build/bin/rigcal_perf_time_sync --smoke     (2 minutes instead of an hour: make test runs this)
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <cstring>
 
 #include "rigcal/rig/rig_yaml.h"
 #include "rigcal/sim/imu.h"
@@ -17,6 +19,8 @@
 namespace {
 
 using namespace rigcal;
+
+bool g_smoke = false;
 
 struct Streams {
   time_sync::AngularRates reference, other;
@@ -37,7 +41,7 @@ Streams simulate_one_hour(double drift_ppm) {
     rig::sensor(rig, "imu").time_offset = 0.0421;
     sim::SimConfig cfg;
     cfg.seed = 1;
-    cfg.imu_duration_s = 3600.0;
+    cfg.imu_duration_s = g_smoke ? 120.0 : 3600.0;
     cfg.imu.drift_ppm = drift_ppm;
     const sim::ImuPart part = sim::simulate_imu_part(rig, cfg);
     return Streams{rates_of(part.os_imu), rates_of(part.imu)};
@@ -102,4 +106,14 @@ BENCHMARK(BM_PeerIntegerLagCorrelationOneHour)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
-BENCHMARK_MAIN();
+// --smoke (first argument): a short stream instead, for make test's run of each benchmark.
+int main(int argc, char** argv) {
+  if (argc >= 2 && std::strcmp(argv[1], "--smoke") == 0) {
+    g_smoke = true;
+    argv[1] = argv[0];
+    ++argv, --argc;
+  }
+  benchmark::Initialize(&argc, argv);
+  benchmark::RunSpecifiedBenchmarks();
+  return 0;
+}

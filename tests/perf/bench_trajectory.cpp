@@ -2,6 +2,7 @@
 // association + SE(3) alignment + ATE + KITTI RPE, in memory; and file parsing.
 //   build/bin/rigcal_perf_trajectory                       (Google Benchmark)
 //   build/bin/rigcal_perf_trajectory --write DIR [N]       (writes DIR/gt.txt, DIR/est.txt)
+//   build/bin/rigcal_perf_trajectory --smoke               (10,000 poses: make test runs this)
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
 
@@ -15,6 +16,9 @@
 namespace {
 
 using namespace rigcal;
+
+// --smoke: every size divided by this (make test runs each benchmark once, small).
+size_t g_size_divisor = 1;
 
 // A 10 Hz drive (~1 m a frame), GT and an estimate with drift on stamps 1 ms later.
 std::pair<Trajectory, Trajectory> make_pair(size_t n) {
@@ -41,7 +45,8 @@ std::pair<Trajectory, Trajectory> make_pair(size_t n) {
 }
 
 void BM_AssociateAlignAteKittiRpe(benchmark::State& state) {
-  const auto [gt, est] = make_pair(static_cast<size_t>(state.range(0)));
+  const size_t n = static_cast<size_t>(state.range(0)) / g_size_divisor;
+  const auto [gt, est] = make_pair(n);
   for (auto _ : state) {
     const bench::Matches m = bench::associate_evo(gt, est, Time::from_ns(10'000'000));
     std::vector<SE3> g, e;
@@ -57,12 +62,12 @@ void BM_AssociateAlignAteKittiRpe(benchmark::State& state) {
         g, e, {std::begin(bench::kKittiLengths), std::end(bench::kKittiLengths)}, 10));
     benchmark::DoNotOptimize(ate.rmse + rpe.trans_pct);
   }
-  state.SetItemsProcessed(state.iterations() * state.range(0));
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(n));
 }
 BENCHMARK(BM_AssociateAlignAteKittiRpe)->Arg(1'000'000)->Unit(benchmark::kMillisecond);
 
 void BM_ParseTum(benchmark::State& state) {
-  const auto [gt, est] = make_pair(static_cast<size_t>(state.range(0)));
+  const auto [gt, est] = make_pair(static_cast<size_t>(state.range(0)) / g_size_divisor);
   const std::string text = io::trajectory_to_tum(gt);
   for (auto _ : state) {
     benchmark::DoNotOptimize(io::parse_trajectory(text, "gt.txt").trajectory.size());
@@ -82,6 +87,11 @@ int main(int argc, char** argv) {
          {std::string(argv[2]) + "/est.txt", rigcal::io::trajectory_to_tum(est)}});
     fmt::print("wrote {}/gt.txt and {}/est.txt, {} poses each\n", argv[2], argv[2], n);
     return 0;
+  }
+  if (argc >= 2 && std::strcmp(argv[1], "--smoke") == 0) {
+    g_size_divisor = 100;
+    argv[1] = argv[0];
+    ++argv, --argc;
   }
   benchmark::Initialize(&argc, argv);
   benchmark::RunSpecifiedBenchmarks();

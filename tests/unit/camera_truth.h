@@ -21,5 +21,7 @@ struct TruthZ {
 
 // Every seed's figures are printed; nothing is asserted per seed.
 TruthZ check_against_truth_for_long_test(rig::DistortionModel model, uint64_t seed);
+// The same with the 6 x 6 AprilGrid (88 mm tags), radtan.
+TruthZ check_aprilgrid_for_long_test(uint64_t seed);
 
 }  // namespace rigcal::camera

@@ -29,35 +29,46 @@ double rotation_error_deg(const SE3& a, const SE3& b) {
   return rotation_angle(a.R * b.R.transpose()) * 180.0 / M_PI;
 }
 
-// Acceptance 2 and 1 on seed 1: 10 pairs with a person-sized box next to the board: the board is
-// found in every scan; rotation <= 0.1 deg (0.039 measured), translation <= 5 mm, both within 3
-// reported sigmas. Over 20 seeds (make test-long) the rotation is <= 0.1 deg in 15 of 20: its
-// 1-sigma about the camera's optical axis is 0.05-0.11 deg with 10 boards (doc/lidar-camera.md).
+// Acceptance 2 and 1: 10 pairs with a person-sized box next to the board, seeds 1-3: the board is
+// found in every scan; translation <= 5 mm, rotation and translation within 3 reported sigmas.
+// The 0.1 deg rotation bar is a rate, not a per-seed promise (its 1-sigma about the camera's
+// optical axis is 0.05-0.11 deg with 10 boards; 15 of 20 seeds in make test-long, which asserts at
+// least 70 %, doc/lidar-camera.md): here at least 2 of the 3 seeds (seed 1: 0.039 deg).
 TEST(LidarCameraSim, TenPairsWithClutter) {
-  const testing::SimRun r = testing::simulate_and_solve(1);
-  const Solution& s = r.solution;
-  const double rot = rotation_error_deg(s.T_camera_lidar, r.truth);
-  const Eigen::Vector3d e = s.T_camera_lidar.t - r.truth.t;
-  std::printf(
-      "found the board in %d of %d scans; closed form %.4f deg %.1f mm; refined %.4f deg (1-sigma "
-      "%.4f %.4f %.4f), %.2f mm (%.2f %.2f %.2f; 1-sigma %.2f %.2f %.2f); noise scale %.2f; "
-      "normals' condition %.1f\n",
-      r.found, r.pairs, rotation_error_deg(s.closed_form, r.truth),
-      1e3 * (s.closed_form.t - r.truth.t).norm(), rot, s.rotation_sigma_deg[0],
-      s.rotation_sigma_deg[1], s.rotation_sigma_deg[2], 1e3 * e.norm(), 1e3 * e.x(), 1e3 * e.y(),
-      1e3 * e.z(), 1e3 * s.translation_sigma_m[0], 1e3 * s.translation_sigma_m[1],
-      1e3 * s.translation_sigma_m[2], s.noise_scale, s.observability.condition);
-  for (const PairResidual& p : s.residuals) {
-    std::printf("  normal %.3f deg, distance %.1f mm, points RMS %.1f mm%s\n", p.normal_angle_deg,
-                1e3 * p.distance_m, 1e3 * p.point_rms_m, p.outlier ? " (outlier)" : "");
+  int rot_ok = 0;
+  for (uint64_t seed = 1; seed <= 3; ++seed) {
+    SCOPED_TRACE(seed);
+    const testing::SimRun r = testing::simulate_and_solve(seed, 10, seed == 1);
+    const Solution& s = r.solution;
+    const double rot = rotation_error_deg(s.T_camera_lidar, r.truth);
+    const Eigen::Vector3d e = s.T_camera_lidar.t - r.truth.t;
+    std::printf(
+        "seed %llu: found the board in %d of %d scans; closed form %.4f deg %.1f mm; refined %.4f "
+        "deg (1-sigma %.4f %.4f %.4f), %.2f mm (%.2f %.2f %.2f; 1-sigma %.2f %.2f %.2f); noise "
+        "scale %.2f; normals' condition %.1f\n",
+        static_cast<unsigned long long>(seed), r.found, r.pairs,
+        rotation_error_deg(s.closed_form, r.truth), 1e3 * (s.closed_form.t - r.truth.t).norm(), rot,
+        s.rotation_sigma_deg[0], s.rotation_sigma_deg[1], s.rotation_sigma_deg[2], 1e3 * e.norm(),
+        1e3 * e.x(), 1e3 * e.y(), 1e3 * e.z(), 1e3 * s.translation_sigma_m[0],
+        1e3 * s.translation_sigma_m[1], 1e3 * s.translation_sigma_m[2], s.noise_scale,
+        s.observability.condition);
+    if (seed == 1) {
+      for (const PairResidual& p : s.residuals) {
+        std::printf("  normal %.3f deg, distance %.1f mm, points RMS %.1f mm%s\n",
+                    p.normal_angle_deg, 1e3 * p.distance_m, 1e3 * p.point_rms_m,
+                    p.outlier ? " (outlier)" : "");
+      }
+    }
+    rot_ok += rot <= 0.1;
+    EXPECT_EQ(r.found, r.pairs);
+    EXPECT_LE(e.norm(), 0.005);
+    const Eigen::Vector3d dr = rotation_vector(s.T_camera_lidar.R * r.truth.R.transpose());
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_LE(std::abs(e[i]), 3 * s.translation_sigma_m[i]) << i;
+      EXPECT_LE(std::abs(dr[i]) * 180 / M_PI, 3 * s.rotation_sigma_deg[i]) << i;
+    }
   }
-  EXPECT_EQ(r.found, r.pairs);
-  EXPECT_LE(rot, 0.1);
-  EXPECT_LE(e.norm(), 0.005);
-  for (int i = 0; i < 3; ++i) EXPECT_LE(std::abs(e[i]), 3 * s.translation_sigma_m[i]) << i;
-  const Eigen::Vector3d dr = rotation_vector(s.T_camera_lidar.R * r.truth.R.transpose());
-  for (int i = 0; i < 3; ++i)
-    EXPECT_LE(std::abs(dr[i]) * 180 / M_PI, 3 * s.rotation_sigma_deg[i]) << i;
+  EXPECT_GE(rot_ok, 2);
 }
 
 // The board's points are the board's: the stand's post just below the board (1-2 cm behind its

@@ -13,6 +13,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
@@ -232,7 +233,10 @@ TEST_F(Session, CalibrateNamesTheFailedStepThenRerunsOnlyIt) {
   EXPECT_NE(last_line.find("(nothing published)\n"), std::string::npos) << bad.err;
   for (const char* step : {"cameras", "time_sync", "hand_eye"}) {
     EXPECT_NE(bad.out.find(fmt::format("== {}: ok", step)), std::string::npos) << bad.out;
-    EXPECT_TRUE(fs::exists(out / "reports" / step / fmt::format("{}.json", step))) << step;
+    // The kept steps' reports say so: the JSON parses, status ok.
+    const fs::path json = out / "reports" / step / fmt::format("{}.json", step);
+    ASSERT_TRUE(fs::exists(json)) << step;
+    EXPECT_EQ(nlohmann::json::parse(slurp(json))["status"], "ok") << step;
   }
 
   fs::remove_all(images);
