@@ -191,7 +191,11 @@ std::vector<Eigen::Vector3d> read_pcd(const std::filesystem::path& path) {
       std::vector<int>& v = key == "SIZE" ? sizes : counts;
       for (const std::string& s : rest) v.push_back(static_cast<int>(parse_int(s, key)));
     }
-    if (key == "POINTS") points = static_cast<size_t>(parse_int(rest.at(0), "POINTS"));
+    if (key == "POINTS") {
+      const long long n = rest.empty() ? -1 : parse_int(rest[0], "POINTS");
+      if (n < 0) throw Error(fmt::format("{}:{}: POINTS needs a count >= 0", name, line_no));
+      points = static_cast<size_t>(n);
+    }
     if (key == "DATA") data_kind = rest.empty() ? "" : rest[0];
   }
   if (counts.empty()) counts.assign(fields.size(), 1);

@@ -1,0 +1,57 @@
+// Inputs the fuzz targets (tests/fuzz, doc/testing.md) found crashing a parser, each now a
+// rigcal::Error naming the file: the same inputs are replayed from tests/fuzz/regressions/.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "rigcal/core/error.h"
+#include "rigcal/io/point_cloud_io.h"
+
+namespace rigcal {
+namespace {
+
+namespace fs = std::filesystem;
+
+class FuzzFindings : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("rigcal_fuzz_findings_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path write(const fs::path& rel, const std::string& bytes) {
+    fs::create_directories((dir_ / rel).parent_path());
+    std::ofstream(dir_ / rel, std::ios::binary) << bytes;
+    return dir_ / rel;
+  }
+  // The message of the rigcal::Error `f` throws ("" and a failure when it throws nothing).
+  template <class F>
+  static std::string error_of(F&& f) {
+    try {
+      f();
+    } catch (const Error& e) {
+      return e.what();
+    }
+    ADD_FAILURE() << "no rigcal::Error";
+    return "";
+  }
+  fs::path dir_;
+};
+
+constexpr const char* kPcdHeader =
+    "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 1\nHEIGHT 1\n";
+
+TEST_F(FuzzFindings, PcdPointsWithoutACount) {
+  // Was std::out_of_range (POINTS with no value), and a negative count a std::length_error.
+  for (const char* points : {"POINTS\n", "POINTS -1\n"}) {
+    const fs::path f = write("a.pcd", std::string(kPcdHeader) + points + "DATA ascii\n1 2 3\n");
+    const std::string e = error_of([&] { io::read_point_cloud(f); });
+    EXPECT_NE(e.find("a.pcd:8: POINTS needs a count >= 0"), std::string::npos) << e;
+  }
+}
+
+}  // namespace
+}  // namespace rigcal
