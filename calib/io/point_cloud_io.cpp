@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -189,7 +190,15 @@ std::vector<Eigen::Vector3d> read_pcd(const std::filesystem::path& path) {
     if (key == "TYPE") types = rest;
     if (key == "SIZE" || key == "COUNT") {
       std::vector<int>& v = key == "SIZE" ? sizes : counts;
-      for (const std::string& s : rest) v.push_back(static_cast<int>(parse_int(s, key)));
+      for (const std::string& s : rest) {
+        // SIZE is 1, 2, 4 or 8 bytes; COUNT bounded so that a record's size cannot overflow.
+        const long long n = parse_int(s, key);
+        if (key == "SIZE" ? n != 1 && n != 2 && n != 4 && n != 8 : n < 1 || n > 65536) {
+          throw Error(fmt::format("{}:{}: {} '{}' (SIZE 1, 2, 4 or 8; COUNT 1 to 65536)", name,
+                                  line_no, key, s));
+        }
+        v.push_back(static_cast<int>(n));
+      }
     }
     if (key == "POINTS") {
       const long long n = rest.empty() ? -1 : parse_int(rest[0], "POINTS");
@@ -205,8 +214,8 @@ std::vector<Eigen::Vector3d> read_pcd(const std::filesystem::path& path) {
         fmt::format("{}: PCD header incomplete (FIELDS, SIZE, TYPE, COUNT disagree)", name));
   }
   int ix = -1, iy = -1, iz = -1;
-  std::vector<int> offset(fields.size()), column(fields.size());
-  int stride = 0, columns = 0;
+  std::vector<size_t> offset(fields.size()), column(fields.size());
+  size_t stride = 0, columns = 0;
   for (size_t i = 0; i < fields.size(); ++i) {
     if (fields[i] == "x") ix = static_cast<int>(i);
     if (fields[i] == "y") iy = static_cast<int>(i);
@@ -221,14 +230,22 @@ std::vector<Eigen::Vector3d> read_pcd(const std::filesystem::path& path) {
       throw Error(fmt::format("{}: PCD field {} is not float32 or float64", name, fields[i]));
     }
   }
+  // What is left of the file after the header bounds what POINTS may make us allocate.
+  size_t data_bytes = 0;
+  if (in) {
+    const std::streampos data_start = in.tellg();
+    in.seekg(0, std::ios::end);
+    data_bytes = static_cast<size_t>(in.tellg() - data_start);
+    in.seekg(data_start);
+  }
   std::vector<Eigen::Vector3d> out;
-  out.reserve(points);
   if (data_kind == "ascii") {
+    out.reserve(std::min(points, data_bytes / 6));  // "0 0 0\n" at the least
     while (std::getline(in, line)) {
       ++line_no;
       const std::vector<std::string_view> f = split_fields(line);
       if (f.empty()) continue;
-      if (static_cast<int>(f.size()) < columns) {
+      if (f.size() < columns) {
         throw Error(
             fmt::format("{}:{}: {} values, the header says {}", name, line_no, f.size(), columns));
       }
@@ -238,7 +255,11 @@ std::vector<Eigen::Vector3d> read_pcd(const std::filesystem::path& path) {
       keep(out, val(ix), val(iy), val(iz));
     }
   } else if (data_kind == "binary") {
-    std::string buf(static_cast<size_t>(stride) * points, '\0');
+    if (points > data_bytes / stride) {
+      throw Error(fmt::format("{}: binary PCD shorter than its {} points", name, points));
+    }
+    out.reserve(points);
+    std::string buf(stride * points, '\0');
     in.read(buf.data(), static_cast<std::streamsize>(buf.size()));
     if (static_cast<size_t>(in.gcount()) != buf.size()) {
       throw Error(fmt::format("{}: binary PCD shorter than its {} points", name, points));

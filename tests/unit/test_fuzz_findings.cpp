@@ -53,5 +53,24 @@ TEST_F(FuzzFindings, PcdPointsWithoutACount) {
   }
 }
 
+TEST_F(FuzzFindings, PcdHostileSizes) {
+  // POINTS beyond what the file holds allocated it all first (48 GB binary, 24 GB ascii: out of
+  // memory); SIZE times COUNT overflowed an int (undefined behaviour).
+  const std::string binary =
+      std::string(kPcdHeader) + "POINTS 4000000000\nDATA binary\n" + std::string(12, '\0');
+  std::string e = error_of([&] { io::read_point_cloud(write("b.pcd", binary)); });
+  EXPECT_NE(e.find("binary PCD shorter than its 4000000000 points"), std::string::npos) << e;
+  const fs::path ascii =
+      write("c.pcd", std::string(kPcdHeader) + "POINTS 1000000000\nDATA ascii\n1 2 3\n");
+  EXPECT_EQ(io::read_point_cloud(ascii).size(), 1u);  // POINTS is only a hint in ASCII
+  const fs::path big = write("d.pcd",
+                             "VERSION 0.7\nFIELDS x y z pad\nSIZE 4 4 4 2147483647\nTYPE F F F "
+                             "U\nCOUNT 1 1 1 2\nPOINTS 1\nDATA binary\n0123456789ab");
+  e = error_of([&] { io::read_point_cloud(big); });
+  EXPECT_NE(e.find("d.pcd:3: SIZE '2147483647' (SIZE 1, 2, 4 or 8; COUNT 1 to 65536)"),
+            std::string::npos)
+      << e;
+}
+
 }  // namespace
 }  // namespace rigcal
