@@ -9,6 +9,7 @@
 
 #include "rigcal/core/error.h"
 #include "rigcal/io/point_cloud_io.h"
+#include "rigcal/rig/rig_yaml.h"
 
 namespace rigcal {
 namespace {
@@ -70,6 +71,17 @@ TEST_F(FuzzFindings, PcdHostileSizes) {
   EXPECT_NE(e.find("d.pcd:3: SIZE '2147483647' (SIZE 1, 2, 4 or 8; COUNT 1 to 65536)"),
             std::string::npos)
       << e;
+}
+
+TEST_F(FuzzFindings, RigNotesRead) {
+  // rigcal.notes was read through a dangling reference (stack-use-after-scope under ASan).
+  const rig::Rig rig = rig::parse_rig_yaml(
+      "rigcal:\n  format_version: 1\n  notes: [first, second]\nlidar:\n  sensor_type: lidar\n"
+      "  T_b: [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]\n",
+      "notes.yaml");
+  ASSERT_EQ(rig.notes.size(), 2u);
+  EXPECT_EQ(rig.notes[0], "first");
+  EXPECT_EQ(rig.notes[1], "second");
 }
 
 }  // namespace
