@@ -32,10 +32,14 @@ camera::Target parse_target_yaml(std::string_view text, std::string_view file) {
   auto integer = [&](const char* key) {
     const double v = number(key);
     if (v != std::floor(v)) fail_at(file, line(root[key]), key, "expected a whole number");
+    // Checked before the conversion to int, which is undefined beyond its range (1e300, inf).
+    if (std::abs(v) > 1e6) fail_at(file, line(root[key]), key, "expected at most 1000000");
     return static_cast<int>(v);
   };
   camera::Target t;
-  const std::string type = get("target_type").as<std::string>();
+  const YAML::Node type_node = get("target_type");
+  if (!type_node.IsScalar()) fail_at(file, line(type_node), "target_type", "expected a word");
+  const std::string type = type_node.Scalar();
   std::set<std::string> known = {"target_type", "name", "margin", "thickness"};
   if (type == "checkerboard") {
     t.type = camera::TargetType::checkerboard;

@@ -9,6 +9,7 @@
 
 #include "rigcal/core/error.h"
 #include "rigcal/io/point_cloud_io.h"
+#include "rigcal/io/target_yaml.h"
 #include "rigcal/rig/rig_yaml.h"
 
 namespace rigcal {
@@ -82,6 +83,21 @@ TEST_F(FuzzFindings, RigNotesRead) {
   ASSERT_EQ(rig.notes.size(), 2u);
   EXPECT_EQ(rig.notes[0], "first");
   EXPECT_EQ(rig.notes[1], "second");
+}
+
+TEST_F(FuzzFindings, TargetYamlTypeAndSizes) {
+  // target_type as a map was YAML::BadConversion; targetCols 1e300 an int conversion out of range
+  // (undefined behaviour).
+  std::string e = error_of(
+      [] { io::parse_target_yaml("target_type: {checkerboard: 1}\ntargetCols: 9\n", "t.yaml"); });
+  EXPECT_NE(e.find("t.yaml:1: key 'target_type': expected a word"), std::string::npos) << e;
+  e = error_of([] {
+    io::parse_target_yaml(
+        "target_type: checkerboard\ntargetCols: 1e300\ntargetRows: 6\nrowSpacingMeters: "
+        "0.025\ncolSpacingMeters: 0.025\n",
+        "t.yaml");
+  });
+  EXPECT_NE(e.find("t.yaml:2: key 'targetCols': expected at most 1000000"), std::string::npos) << e;
 }
 
 }  // namespace
