@@ -2,8 +2,16 @@
 BUILD ?= build
 BUILD_TYPE ?= Release
 JOBS ?= $(shell nproc)
+# The sanitizer build (ASan + UBSan, clang, the libFuzzer targets): doc/testing.md.
+ASAN_BUILD ?= build-asan
+ASAN_CC ?= clang-14
+ASAN_CXX ?= clang++-14
+ASAN_FLAGS ?= -O1 -gline-tables-only -DNDEBUG
+# `make test SANITIZE=1` adds the sanitizer build (not yet within CI's 20 minutes: doc/testing.md).
+SANITIZE ?= 0
 
-.PHONY: all deps configure build demo test test-long install clean format
+.PHONY: all deps configure build demo test test-fast test-asan configure-asan build-asan \
+        test-long install clean format
 
 all: build
 
@@ -19,13 +27,31 @@ build: configure
 demo: build
 	@bash scripts/demo.sh $(BUILD)
 
-# Every test but the long statistical ones (CTest label "long").
-test: build
+configure-asan: deps
+	CC=$(ASAN_CC) CXX=$(ASAN_CXX) cmake -S . -B $(ASAN_BUILD) -DRIGCAL_SANITIZE=ON \
+	  -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=$(ASAN_FLAGS)" \
+	  "-DCMAKE_C_FLAGS_RELWITHDEBINFO=$(ASAN_FLAGS)"
+
+build-asan: configure-asan
+	cmake --build $(ASAN_BUILD) -j$(JOBS)
+
+# Every test but the long statistical ones (CTest label "long"): the gcc build (with every fuzz
+# target's seeds and regressions replayed), and with SANITIZE=1 the sanitizer build (its unit
+# tests, the fuzz targets' replays and short runs).
+test: test-fast $(if $(filter 1,$(SANITIZE)),test-asan)
+
+# The gcc build's tests only.
+test-fast: build
 	cd $(BUILD) && ctest --output-on-failure -j$(JOBS) -LE long
 
-# Only the long statistical checks (many seeds, many images).
-test-long: build
+# The sanitizer build's tests only.
+test-asan: build-asan
+	cd $(ASAN_BUILD) && ctest --output-on-failure -j$(JOBS) -LE long
+
+# Only the long checks: the statistical ones (many seeds, many images) and the long fuzz runs.
+test-long: build $(if $(filter 1,$(SANITIZE)),build-asan)
 	cd $(BUILD) && ctest --output-on-failure -j$(JOBS) -L long
+	$(if $(filter 1,$(SANITIZE)),cd $(ASAN_BUILD) && ctest --output-on-failure -j$(JOBS) -L long)
 
 install: build
 	cmake --install $(BUILD) $(if $(PREFIX),--prefix $(PREFIX),)
@@ -34,4 +60,4 @@ format:
 	find calib apps tests -name '*.h' -o -name '*.cpp' | xargs clang-format -i
 
 clean:
-	rm -rf $(BUILD)
+	rm -rf $(BUILD) $(ASAN_BUILD)

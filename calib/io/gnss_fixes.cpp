@@ -108,8 +108,10 @@ GnssFixes parse_gnss_fixes(std::string_view text, std::string_view file_name, At
   std::vector<double> std_h, std_v;
   const Eigen::Matrix3d R_enu_ned = (Eigen::Matrix3d() << 0, 1, 0, 1, 0, 0, 0, 0, -1).finished();
   const double deg = M_PI / 180.0;
-  for (const auto& [number, line] : rows) {
-    const std::vector<std::string_view> f = split_fields(line);
+  for (const auto& row : rows) {
+    // Not a structured binding: clang 14 (the sanitizer build) cannot capture one in a lambda.
+    const int number = row.first;
+    const std::vector<std::string_view> f = split_fields(row.second);
     auto value = [&](Column c) {
       const int i = col[c];
       if (i >= static_cast<int>(f.size())) {

@@ -239,7 +239,8 @@ std::vector<Eigen::Vector3d> without_stubs(const std::vector<Eigen::Vector3d>& p
   for (const auto& [along, across, size_across] : {std::tuple{a, b, H}, std::tuple{b, a, W}}) {
     const double strip = 0.01;
     std::map<int, std::pair<double, double>> span;  // strip -> min, max across
-    auto strip_of = [&](const Eigen::Vector3d& x) {
+    // `along` copied: clang 14 (the sanitizer build) cannot capture a structured binding.
+    auto strip_of = [&, along = along](const Eigen::Vector3d& x) {
       return static_cast<int>(std::floor(along.dot(c.B.transpose() * x) / strip));
     };
     for (const Eigen::Vector3d& x : out) {

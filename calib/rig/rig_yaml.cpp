@@ -320,8 +320,11 @@ void read_metadata(Reader& r, const YAML::Node& node, Rig& rig) {
     } else if (key == "base_frame") {
       rig.base_frame = r.text(it->second, full);
     } else if (key == "notes") {
-      if (!it->second.IsSequence()) r.fail(it->second, full, "expected a list of text lines");
-      for (const YAML::Node& n : it->second) rig.notes.push_back(r.text(n, full));
+      // A copy: the range of a range-for over it->second, a member reached through the temporary
+      // proxy that operator-> returns, would outlive it (stack-use-after-scope under ASan).
+      const YAML::Node notes = it->second;
+      if (!notes.IsSequence()) r.fail(notes, full, "expected a list of text lines");
+      for (const YAML::Node& n : notes) rig.notes.push_back(r.text(n, full));
     } else if (key != "written_by") {
       rig.extra_metadata.emplace_back(key, flow_text(it->second));
     }

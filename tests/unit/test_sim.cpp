@@ -279,8 +279,9 @@ TEST(SimImu, TheWrittenClockOffsetIsRecoverableByBruteForce) {
   auto norm_at = [](const std::vector<ImuSample>& s, double t, double offset) -> double {
     const double first = s.front().stamp.seconds() + offset;
     const double k = (t - first) * 100.0;
+    if (k < 0) return std::nan("");  // before converting: a negative double to size_t is UB
     const size_t i = static_cast<size_t>(k);
-    if (k < 0 || i + 1 >= s.size()) return std::nan("");
+    if (i + 1 >= s.size()) return std::nan("");
     const double f = k - i;
     return (1 - f) * s[i].gyro.norm() + f * s[i + 1].gyro.norm();
   };
