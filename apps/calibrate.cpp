@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "cli.h"
+#include "rigcal/core/text.h"
 #include "step_output.h"
 
 namespace rigcal::cli {
@@ -37,7 +38,7 @@ void print_table(const session::CalibrateResult& r) {
                s.cached        ? "cached"
                : s.seconds > 0 ? fmt::format("{:.2f} s", s.seconds)
                                : "-",
-               s.status == "ok" ? result : s.reason);
+               s.status == "ok" ? result : printable(s.reason, 2000));
   }
 }
 
@@ -55,7 +56,7 @@ void run(Options o) {
     fmt::print("== {}: {}{}\n", s.step, s.status, s.cached ? " (cached: inputs unchanged)" : "");
     for (const std::string& line : s.summary) fmt::print("{}\n", line);
     for (const std::string& n : s.notes) fmt::print("note: {}\n", n);
-    if (s.status != "ok") fmt::print("{}: {}\n", s.status, s.reason);
+    if (s.status != "ok") fmt::print("{}: {}\n", s.status, printable(s.reason, 2000));
     if (!s.remedy.empty()) fmt::print("what would settle it: {}\n", s.remedy);
   }
   print_table(r);
@@ -86,7 +87,8 @@ void run(Options o) {
     for (size_t k = 1; k < open.size(); ++k)
       others += fmt::format("{}{} {}", k == 1 ? "; also " : ", ", open[k]->step, open[k]->status);
     fmt::print(stderr, "rigcal: {}: {}: {} (nothing published{})\n",
-               first.status == "failed" ? "error" : first.status, first.step, first.reason, others);
+               first.status == "failed" ? "error" : first.status, first.step,
+               printable(first.reason, 2000), others);
   }
   if (r.exit_status != 0) throw Exit{r.exit_status};
 }

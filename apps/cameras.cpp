@@ -83,7 +83,7 @@ void add_cameras(CLI::App& app) {
   cmd->add_option("--report", o->report, "report folder")->required();
   cmd->add_option("--outlier-sigma", o->k_sigma,
                   "drop corners with a residual beyond this many sigma")
-      ->check(finite_number(true))
+      ->check(finite_number(true) & CLI::Range(0.5, 100.0))
       ->capture_default_str();
   cmd->add_option("--bayer", o->bayer,
                   "raw Bayer images: rggb | bggr | grbg | gbrg (demosaiced to gray)");

@@ -94,7 +94,7 @@ void add_lidar_camera(CLI::App& app) {
                   "pairs by stamp on the base clock (the rig's time offsets applied)");
   cmd->add_option("--max-dt", o->step.max_dt_s,
                   "--session: an image takes the nearest scan within this many seconds")
-      ->check(finite_number(true))
+      ->check(finite_number(true) & CLI::Range(1e-6, 3600.0))
       ->capture_default_str();
   cmd->add_option("--images", o->images,
                   "image glob; pairs are matched by the last number in the file names");

@@ -1,7 +1,7 @@
 #include "rigcal/io/files.h"
 
-#include <fmt/format.h>
 #include <fcntl.h>
+#include <fmt/format.h>
 #include <sys/file.h>
 #include <unistd.h>
 
@@ -20,6 +20,11 @@ std::string read_text_file(const fs::path& path, size_t max_bytes) {
   std::error_code ec;
   if (fs::is_directory(path, ec)) {
     throw Error(fmt::format("{}: is a folder, expected a file", path.string()));
+  }
+  // A pipe would block until a writer comes and has no size to read by: refused, as are sockets.
+  if (const fs::file_type t = fs::status(path, ec).type();
+      t == fs::file_type::fifo || t == fs::file_type::socket) {
+    throw Error(fmt::format("{}: a pipe or socket, expected a file", path.string()));
   }
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) {

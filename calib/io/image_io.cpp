@@ -39,8 +39,11 @@ ImageHeader probe_image(std::string_view bytes) {
   const auto* b = reinterpret_cast<const unsigned char*>(bytes.data());
   const size_t n = bytes.size();
   ImageHeader h;
-  if (n >= 24 && bytes.substr(0, 8) == "\x89PNG\r\n\x1a\n" && bytes.substr(12, 4) == "IHDR") {
-    return {ImageFormat::png, big_endian32(b + 16), big_endian32(b + 20), true};
+  if (n >= 8 && bytes.substr(0, 8) == "\x89PNG\r\n\x1a\n") {
+    if (n >= 24 && bytes.substr(12, 4) == "IHDR")
+      return {ImageFormat::png, big_endian32(b + 16), big_endian32(b + 20), true};
+    h.format = ImageFormat::png;  // no header: check_png_chunks names what is missing
+    return h;
   }
   if (n >= 3 && b[0] == 0xFF && b[1] == 0xD8 && b[2] == 0xFF) {
     h.format = ImageFormat::jpeg;

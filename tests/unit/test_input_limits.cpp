@@ -2,6 +2,7 @@
 // documented limits, before allocating what a header claims, and without anything on stderr.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include <zlib.h>
 
@@ -111,6 +112,13 @@ TEST_F(InputLimits, DamagedPngIsAnErrorAndStderrStaysQuiet) {
   EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
   EXPECT_NE(what.find(damaged.string() + ": PNG chunk 'IDAT' at byte "), std::string::npos) << what;
   EXPECT_NE(what.find("is damaged (CRC mismatch)"), std::string::npos) << what;
+
+  // The signature alone (libpng printed "Invalid IHDR data" on stderr).
+  const fs::path bare = write("bare.png", good.substr(0, 8));
+  ::testing::internal::CaptureStderr();
+  EXPECT_EQ(error_of([&] { read_gray(bare); }),
+            bare.string() + ": PNG truncated at byte 8 (no IEND chunk)");
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
 
   const fs::path cut = write("cut.png", good.substr(0, good.size() - 20));
   EXPECT_NE(error_of([&] { read_gray(cut); }).find(cut.string() + ": PNG "), std::string::npos);
@@ -229,6 +237,13 @@ TEST_F(InputLimits, TargetsOutsideWhatPeoplePrintAreRefused) {
             "t.yaml: target 't': thickness: must be in [0, 0.2] m");
   EXPECT_EQ(message("8", "0.04", "name: [a, b]\n"), "t.yaml:6: key 'name': expected a text value");
   EXPECT_NO_THROW(parse_target_yaml(fmt::format(fmt::runtime(board), 8, 0.04, 0.04, ""), "t.yaml"));
+}
+
+TEST_F(InputLimits, PipesAreRefusedNotWaitedOn) {
+  const fs::path fifo = dir_ / "pipe.yaml";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_EQ(error_of([&] { rig::read_rig_file(fifo); }),
+            fifo.string() + ": a pipe or socket, expected a file");
 }
 
 TEST(Printable, InvalidBytesAndLineBreaksAreEscapedAndLongTextCut) {
