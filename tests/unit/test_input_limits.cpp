@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 #include <zlib.h>
 
@@ -17,6 +18,7 @@
 #include "rigcal/camera/target.h"
 #include "rigcal/core/error.h"
 #include "rigcal/core/text.h"
+#include "rigcal/io/files.h"
 #include "rigcal/io/image_io.h"
 #include "rigcal/io/point_cloud_io.h"
 #include "rigcal/io/target_yaml.h"
@@ -244,6 +246,30 @@ TEST_F(InputLimits, PipesAreRefusedNotWaitedOn) {
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   EXPECT_EQ(error_of([&] { rig::read_rig_file(fifo); }),
             fifo.string() + ": a pipe or socket, expected a file");
+}
+
+// Two writers on one output folder: the second is refused while the first holds it, so the
+// folder ends with one run's complete output, never a mixture; the claim ends with its holder.
+TEST_F(InputLimits, OneRunPerOutputFolder) {
+  const fs::path out = dir_ / "out";
+  {
+    const FolderLock first(out);
+    EXPECT_EQ(error_of([&] { FolderLock second(out); }),
+              out.string() +
+                  ": another rigcal run is writing this folder; wait for it to end or choose "
+                  "another output folder");
+    // Another process: rigcal calibrate on the held folder stops before reading anything.
+    const std::string cmd =
+        fmt::format("{} calibrate {} --out {} 2> {}", RIGCAL_CLI, (dir_ / "no_session").string(),
+                    out.string(), (dir_ / "err.txt").string());
+    EXPECT_EQ(WEXITSTATUS(std::system(cmd.c_str())), 2);
+    std::ifstream err(dir_ / "err.txt");
+    std::string line;
+    std::getline(err, line);
+    EXPECT_NE(line.find("another rigcal run is writing this folder"), std::string::npos) << line;
+  }
+  EXPECT_NO_THROW(FolderLock again(out));
+  EXPECT_EQ(std::distance(fs::directory_iterator(out), fs::directory_iterator{}), 0);
 }
 
 TEST(Printable, InvalidBytesAndLineBreaksAreEscapedAndLongTextCut) {
