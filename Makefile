@@ -7,8 +7,8 @@ ASAN_BUILD ?= build-asan
 ASAN_CC ?= clang-14
 ASAN_CXX ?= clang++-14
 ASAN_FLAGS ?= -O1 -gline-tables-only -DNDEBUG
-# `make test SANITIZE=1` adds the sanitizer build (not yet within CI's 20 minutes: doc/testing.md).
-SANITIZE ?= 0
+# `make test SANITIZE=0` (or `make test-fast`) runs the gcc suite only.
+SANITIZE ?= 1
 
 .PHONY: all deps configure build demo test test-fast test-asan configure-asan build-asan \
         test-long install clean format
@@ -36,8 +36,8 @@ build-asan: configure-asan
 	cmake --build $(ASAN_BUILD) -j$(JOBS)
 
 # Every test but the long statistical ones (CTest label "long"): the gcc build (with every fuzz
-# target's seeds and regressions replayed), and with SANITIZE=1 the sanitizer build (its unit
-# tests, the fuzz targets' replays and short runs).
+# target's seeds and regressions replayed), then the sanitizer build (its unit tests, the fuzz
+# targets' replays and short runs).
 test: test-fast $(if $(filter 1,$(SANITIZE)),test-asan)
 
 # The gcc build's tests only.
