@@ -46,7 +46,7 @@ camera::Target parse_target_yaml(std::string_view text, std::string_view file) {
   };
   auto scalar = [&](const char* key) {
     const YAML::Node n = get(key);
-    if (!n.IsScalar()) fail_at(file, line(n), key, "expected a text value");
+    if (!n.IsScalar() || n.Scalar().empty()) fail_at(file, line(n), key, "expected a text value");
     return n.Scalar();
   };
   camera::Target t;
@@ -114,7 +114,9 @@ std::string target_to_yaml(const camera::Target& t) {
         "target_type: aprilgrid\ntagCols: {}\ntagRows: {}\ntagSize: {}\ntagSpacing: {}\n", t.cols,
         t.rows, format_double(t.tag_size), format_double(t.tag_spacing));
   }
-  out += fmt::format("name: {}\n", t.name);
+  YAML::Emitter name;  // quoted when the text needs it (a colon, a leading '!', ...)
+  name << t.name;
+  out += fmt::format("name: {}\n", name.c_str());
   if (t.margin >= 0) out += fmt::format("margin: {}\n", format_double(t.margin));
   out += fmt::format("thickness: {}\n", format_double(t.thickness));
   return out;
