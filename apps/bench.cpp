@@ -5,136 +5,25 @@
 #include <memory>
 
 #include "cli.h"
-#include "rigcal/bench/evaluate.h"
 #include "rigcal/bench/leaderboard.h"
 #include "rigcal/bench/report.h"
+#include "rigcal/bench/step.h"
 #include "rigcal/core/error.h"
-#include "rigcal/io/files.h"
-#include "rigcal/io/trajectory_io.h"
 
 namespace rigcal::cli {
 namespace {
 
-struct Options {
-  std::string gt, est, format = "auto", gt_format, est_format, gt_times, est_times;
-  std::string align, association, convention = "rigcal", report;
-  size_t align_first = 0;
-  double delta = 1;
-  std::string delta_unit = "f";
-  bool all_pairs = false;
-  double max_diff = 0.01, max_gap = 0.5;
-  std::string duplicates;
-  // Leaderboard.
-  std::string gt_dir, est_dir, methods;
-  double ate_max = 10.0, rpe_max = 10.0;
-};
-
-io::TrajectoryReadOptions read_options(const Options& o, const std::string& format,
-                                       const std::string& times) {
-  io::TrajectoryReadOptions r;
-  r.format = io::trajectory_format_from_string(format.empty() ? o.format : format);
-  r.kitti_times = times;
-  // The VBR evaluator reads every line, equal stamps included; the others refuse them by default.
-  r.duplicates = io::duplicates_from_string(
-      o.duplicates.empty() ? (o.convention == "vbr" ? "keep" : "error") : o.duplicates);
-  return r;
+void run_pair(const bench::BenchOptions& o) {
+  for (const std::string& line : bench::pair_summary(o, bench::score_pair(o)))
+    fmt::print("{}\n", line);
 }
 
-bench::EvalOptions eval_options(const Options& o) {
-  bench::EvalOptions e;
-  e.convention = bench::convention_from_string(o.convention);
-  if (!o.align.empty()) e.alignment = bench::alignment_from_string(o.align);
-  if (!o.association.empty()) e.association = bench::association_from_string(o.association);
-  e.align_first_n = o.align_first;
-  e.max_diff = Time::from_seconds(o.max_diff);
-  e.max_gap = Time::from_seconds(o.max_gap);
-  e.delta = o.delta;
-  if (o.delta_unit == "f" || o.delta_unit == "frames")
-    e.delta_unit = bench::DeltaUnit::frames;
-  else if (o.delta_unit == "m" || o.delta_unit == "meters")
-    e.delta_unit = bench::DeltaUnit::meters;
-  else
-    throw Error(
-        fmt::format("--delta-unit: expected f (frames) or m (metres), got '{}'", o.delta_unit));
-  e.all_pairs = o.all_pairs;
-  e.keep_segments = !o.report.empty();
-  return e;
-}
-
-void print_stats(std::string_view label, const bench::Stats& s) {
-  fmt::print(
-      "  {:<16} rmse {:>10.6f}  mean {:>10.6f}  median {:>10.6f}  std {:>10.6f}  min {:>10.6f}  "
-      "max {:>10.6f}\n",
-      label, s.rmse, s.mean, s.median, s.std, s.min, s.max);
-}
-
-void run_pair(const Options& o) {
-  io::TrajectoryFile gt = io::read_trajectory(o.gt, read_options(o, o.gt_format, o.gt_times));
-  io::TrajectoryFile est = io::read_trajectory(o.est, read_options(o, o.est_format, o.est_times));
-  const bench::EvalOptions options = eval_options(o);
-  const bench::EvalResult r = [&] {
-    try {
-      return bench::evaluate(std::move(gt.trajectory), std::move(est.trajectory), options);
-    } catch (const Error& e) {
-      throw Error(fmt::format("{} against {}: {}", o.est, o.gt, e.what()));
-    }
-  }();
-
-  fmt::print("rigcal bench, convention {}\n", bench::to_string(r.convention));
-  fmt::print("  ground truth {} ({} poses, {}{})\n", o.gt, r.n_gt, io::to_string(gt.format),
-             gt.duplicate_stamps ? fmt::format(", {} duplicate stamps", gt.duplicate_stamps) : "");
-  fmt::print(
-      "  estimate     {} ({} poses, {}{})\n", o.est, r.n_est, io::to_string(est.format),
-      est.duplicate_stamps ? fmt::format(", {} duplicate stamps", est.duplicate_stamps) : "");
-  fmt::print("  {} pose pairs ({}), alignment {}{}, GT path {:.3f} m\n", r.n_pairs,
-             bench::to_string(r.association), bench::to_string(r.alignment.method),
-             r.alignment.method == bench::Alignment::sim3
-                 ? fmt::format(" (scale {:.9f})", r.alignment.scale)
-                 : "",
-             r.gt_length);
-  fmt::print("ATE\n");
-  print_stats("translation [m]", r.ate_trans);
-  print_stats("rotation [deg]", r.ate_rot_deg);
-  if (r.vbr_ate_trans) {
-    fmt::print("  VBR's \"ATE\" (sqrt of mean error, not an RMSE): {:.6g} m, {:.6g} deg\n",
-               *r.vbr_ate_trans, *r.vbr_ate_rot);
-  }
-  fmt::print("RPE\n");
-  for (const bench::RpeResult& rpe : r.rpe) {
-    if (rpe.kind == "delta") {
-      fmt::print("  {} ({} pairs)\n", rpe.definition, rpe.trans.n);
-      print_stats("translation [m]", rpe.trans);
-      print_stats("rotation [deg]", rpe.rot_deg);
-    } else if (rpe.drift.n_segments == 0) {
-      fmt::print("  {}: no segment fits in the trajectory\n", rpe.definition);
-    } else {
-      fmt::print(
-          "  {}\n    translation {:.6f} %, rotation {:.6g} deg/m ({:.6g} rad/m), {} segments\n",
-          rpe.definition, rpe.drift.trans_pct, rpe.drift.rot_deg_per_m,
-          rpe.drift.rot_deg_per_m * M_PI / 180.0, rpe.drift.n_segments);
-    }
-  }
-  for (const std::string& n : r.notes) fmt::print("note: {}\n", n);
-  if (!o.report.empty()) {
-    bench::write_bench_report(r, o.report, {{"gt", o.gt}, {"est", o.est}});
-    fmt::print("report: {}/bench.json and plots\n", o.report);
-  }
-}
-
-void run_leaderboard(const Options& o) {
-  if (o.est_dir.empty()) throw Error("--gt-dir needs --est-dir");
-  bench::LeaderboardInput in;
-  in.ate_max = o.ate_max;
-  in.rpe_max = o.rpe_max;
-  const bench::EvalOptions options = eval_options(o);
-  in = bench::load_leaderboard_input(o.gt_dir, o.est_dir, o.methods, read_options(o, "", ""), in);
-  const bench::Leaderboard board = bench::build_leaderboard(
-      in, options, [](std::string_view msg) { fmt::print(stderr, "{}\n", msg); });
+void run_leaderboard(const bench::BenchOptions& o) {
+  const bench::Leaderboard board =
+      bench::score_leaderboard(o, [](std::string_view msg) { fmt::print(stderr, "{}\n", msg); });
   fmt::print("{}", bench::leaderboard_markdown(board));
-  if (!o.report.empty()) {
-    bench::write_leaderboard_report(board, o.report);
+  if (!o.report.empty())
     fmt::print("report: {}/leaderboard.{{md,csv,json}} and cumulative curves\n", o.report);
-  }
   if (bench::scored_entries(board) == 0) {
     fmt::print(stderr,
                "rigcal: error: no run could be scored (every estimate missing or failed)\n");
@@ -145,7 +34,7 @@ void run_leaderboard(const Options& o) {
 }  // namespace
 
 void add_bench(CLI::App& app) {
-  auto o = std::make_shared<Options>();
+  auto o = std::make_shared<bench::BenchOptions>();
   CLI::App* cmd = app.add_subcommand(
       "bench",
       "Score estimated trajectories against ground truth: ATE (after alignment) and RPE.\n"

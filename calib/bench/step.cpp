@@ -1,0 +1,127 @@
+#include "rigcal/bench/step.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "rigcal/bench/report.h"
+#include "rigcal/core/error.h"
+
+namespace rigcal::bench {
+namespace {
+
+std::string stats_line(std::string_view label, const Stats& s) {
+  return fmt::format(
+      "  {:<16} rmse {:>10.6f}  mean {:>10.6f}  median {:>10.6f}  std {:>10.6f}  min {:>10.6f}  "
+      "max {:>10.6f}",
+      label, s.rmse, s.mean, s.median, s.std, s.min, s.max);
+}
+
+}  // namespace
+
+io::TrajectoryReadOptions read_options(const BenchOptions& o, const std::string& format,
+                                       const std::string& times) {
+  io::TrajectoryReadOptions r;
+  r.format = io::trajectory_format_from_string(format.empty() ? o.format : format);
+  r.kitti_times = times;
+  // The VBR evaluator reads every line, equal stamps included; the others refuse them by default.
+  r.duplicates = io::duplicates_from_string(
+      o.duplicates.empty() ? (o.convention == "vbr" ? "keep" : "error") : o.duplicates);
+  return r;
+}
+
+EvalOptions eval_options(const BenchOptions& o) {
+  EvalOptions e;
+  e.convention = convention_from_string(o.convention);
+  if (!o.align.empty()) e.alignment = alignment_from_string(o.align);
+  if (!o.association.empty()) e.association = association_from_string(o.association);
+  e.align_first_n = o.align_first;
+  e.max_diff = Time::from_seconds(o.max_diff);
+  e.max_gap = Time::from_seconds(o.max_gap);
+  e.delta = o.delta;
+  if (o.delta_unit == "f" || o.delta_unit == "frames")
+    e.delta_unit = DeltaUnit::frames;
+  else if (o.delta_unit == "m" || o.delta_unit == "meters")
+    e.delta_unit = DeltaUnit::meters;
+  else
+    throw Error(
+        fmt::format("--delta-unit: expected f (frames) or m (metres), got '{}'", o.delta_unit));
+  e.all_pairs = o.all_pairs;
+  e.keep_segments = !o.report.empty();
+  return e;
+}
+
+PairRun score_pair(const BenchOptions& o) {
+  const EvalOptions options = eval_options(o);
+  PairRun run;
+  run.gt = io::read_trajectory(o.gt, read_options(o, o.gt_format, o.gt_times));
+  run.est = io::read_trajectory(o.est, read_options(o, o.est_format, o.est_times));
+  try {
+    run.result = evaluate(std::move(run.gt.trajectory), std::move(run.est.trajectory), options);
+  } catch (const Error& e) {
+    throw Error(fmt::format("{} against {}: {}", o.est, o.gt, e.what()));
+  }
+  if (!o.report.empty()) write_bench_report(run.result, o.report, {{"gt", o.gt}, {"est", o.est}});
+  return run;
+}
+
+std::vector<std::string> pair_summary(const BenchOptions& o, const PairRun& run) {
+  const EvalResult& r = run.result;
+  auto duplicates = [](const io::TrajectoryFile& f) {
+    return f.duplicate_stamps ? fmt::format(", {} duplicate stamps", f.duplicate_stamps)
+                              : std::string();
+  };
+  std::vector<std::string> out;
+  out.push_back(fmt::format("rigcal bench, convention {}", to_string(r.convention)));
+  out.push_back(fmt::format("  ground truth {} ({} poses, {}{})", o.gt, r.n_gt,
+                            io::to_string(run.gt.format), duplicates(run.gt)));
+  out.push_back(fmt::format("  estimate     {} ({} poses, {}{})", o.est, r.n_est,
+                            io::to_string(run.est.format), duplicates(run.est)));
+  out.push_back(fmt::format("  {} pose pairs ({}), alignment {}{}, GT path {:.3f} m", r.n_pairs,
+                            to_string(r.association), to_string(r.alignment.method),
+                            r.alignment.method == Alignment::sim3
+                                ? fmt::format(" (scale {:.9f})", r.alignment.scale)
+                                : "",
+                            r.gt_length));
+  out.push_back("ATE");
+  out.push_back(stats_line("translation [m]", r.ate_trans));
+  out.push_back(stats_line("rotation [deg]", r.ate_rot_deg));
+  if (r.vbr_ate_trans) {
+    out.push_back(
+        fmt::format("  VBR's \"ATE\" (sqrt of mean error, not an RMSE): {:.6g} m, {:.6g} deg",
+                    *r.vbr_ate_trans, *r.vbr_ate_rot));
+  }
+  out.push_back("RPE");
+  for (const RpeResult& rpe : r.rpe) {
+    if (rpe.kind == "delta") {
+      out.push_back(fmt::format("  {} ({} pairs)", rpe.definition, rpe.trans.n));
+      out.push_back(stats_line("translation [m]", rpe.trans));
+      out.push_back(stats_line("rotation [deg]", rpe.rot_deg));
+    } else if (rpe.drift.n_segments == 0) {
+      out.push_back(fmt::format("  {}: no segment fits in the trajectory", rpe.definition));
+    } else {
+      out.push_back(fmt::format(
+          "  {}\n    translation {:.6f} %, rotation {:.6g} deg/m ({:.6g} rad/m), {} segments",
+          rpe.definition, rpe.drift.trans_pct, rpe.drift.rot_deg_per_m,
+          rpe.drift.rot_deg_per_m * M_PI / 180.0, rpe.drift.n_segments));
+    }
+  }
+  for (const std::string& n : r.notes) out.push_back(fmt::format("note: {}", n));
+  if (!o.report.empty()) out.push_back(fmt::format("report: {}/bench.json and plots", o.report));
+  return out;
+}
+
+Leaderboard score_leaderboard(const BenchOptions& o,
+                              const std::function<void(std::string_view)>& tell) {
+  if (o.est_dir.empty()) throw Error("--gt-dir needs --est-dir");
+  const EvalOptions options = eval_options(o);
+  LeaderboardInput in;
+  in.ate_max = o.ate_max;
+  in.rpe_max = o.rpe_max;
+  in = load_leaderboard_input(o.gt_dir, o.est_dir, o.methods, read_options(o, "", ""), in);
+  const Leaderboard board = build_leaderboard(in, options, tell);
+  if (!o.report.empty()) write_leaderboard_report(board, o.report);
+  return board;
+}
+
+}  // namespace rigcal::bench

@@ -1,0 +1,52 @@
+#pragma once
+// The benchmark as one step (doc/bench.md): one estimate against its ground truth, or a
+// leaderboard of methods over sequences, from files, with the report written where asked. The
+// command line only parses options into BenchOptions and prints the lines returned.
+#include <functional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "rigcal/bench/evaluate.h"
+#include "rigcal/bench/leaderboard.h"
+#include "rigcal/io/trajectory_io.h"
+
+namespace rigcal::bench {
+
+struct BenchOptions {
+  std::string gt, est, format = "auto", gt_format, est_format, gt_times, est_times;
+  std::string align, association, convention = "rigcal", report;
+  size_t align_first = 0;
+  double delta = 1;
+  std::string delta_unit = "f";
+  bool all_pairs = false;
+  double max_diff = 0.01, max_gap = 0.5;
+  std::string duplicates;
+  // Leaderboard.
+  std::string gt_dir, est_dir, methods;
+  double ate_max = 10.0, rpe_max = 10.0;
+};
+
+// The reader's options for one file: `format` and `times` override the shared ones when given; the
+// duplicate-stamp policy is the convention's default (keep for vbr, error otherwise) unless set.
+io::TrajectoryReadOptions read_options(const BenchOptions& o, const std::string& format,
+                                       const std::string& times);
+// Throws rigcal::Error naming the option on an unknown value.
+EvalOptions eval_options(const BenchOptions& o);
+
+struct PairRun {
+  io::TrajectoryFile gt, est;  // as read (their trajectories moved into the evaluation)
+  EvalResult result;
+};
+// Reads o.gt and o.est, scores them, writes the report when o.report is set. Throws
+// rigcal::Error naming both files when they cannot be scored.
+PairRun score_pair(const BenchOptions& o);
+// The figures as the command prints them, one line each.
+std::vector<std::string> pair_summary(const BenchOptions& o, const PairRun& run);
+
+// Loads the leaderboard's folders, scores every run (`tell` receives a line per failure) and
+// writes the report when o.report is set.
+Leaderboard score_leaderboard(const BenchOptions& o,
+                              const std::function<void(std::string_view)>& tell);
+
+}  // namespace rigcal::bench
