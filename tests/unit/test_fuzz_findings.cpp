@@ -7,6 +7,7 @@
 #include <fstream>
 #include <string>
 
+#include "fixtures.h"
 #include "rigcal/core/error.h"
 #include "rigcal/io/point_cloud_io.h"
 #include "rigcal/io/target_yaml.h"
@@ -17,31 +18,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class FuzzFindings : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("rigcal_fuzz_findings_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path write(const fs::path& rel, const std::string& bytes) {
-    fs::create_directories((dir_ / rel).parent_path());
-    std::ofstream(dir_ / rel, std::ios::binary) << bytes;
-    return dir_ / rel;
-  }
-  // The message of the rigcal::Error `f` throws ("" and a failure when it throws nothing).
-  template <class F>
-  static std::string error_of(F&& f) {
-    try {
-      f();
-    } catch (const Error& e) {
-      return e.what();
-    }
-    ADD_FAILURE() << "no rigcal::Error";
-    return "";
-  }
-  fs::path dir_;
-};
+using FuzzFindings = testing::ScratchTest;
 
 constexpr const char* kPcdHeader =
     "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n";

@@ -30,30 +30,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class InputLimits : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("rigcal_limits_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path write(const std::string& name, const std::string& bytes) {
-    std::ofstream(dir_ / name, std::ios::binary) << bytes;
-    return dir_ / name;
-  }
-  // The message of the rigcal::Error `f` throws; "" (a test failure) when it throws nothing.
-  template <typename F>
-  static std::string error_of(F&& f) {
-    try {
-      f();
-    } catch (const Error& e) {
-      return e.what();
-    }
-    ADD_FAILURE() << "no rigcal::Error";
-    return "";
-  }
-  fs::path dir_;
-};
+using InputLimits = testing::ScratchTest;
 
 std::string slurp_sample_rig() {
   std::ifstream in(RIGCAL_SOURCE_DIR "/data/sample_rig.yaml");
