@@ -15,6 +15,7 @@
 #include "rigcal/sim/imu.h"
 #include "rigcal/sim/session.h"
 #include "rigcal/time_sync/time_sync.h"
+#include "smoke.h"
 
 namespace {
 
@@ -108,12 +109,6 @@ BENCHMARK(BM_PeerIntegerLagCorrelationOneHour)->Unit(benchmark::kMillisecond);
 
 // --smoke (first argument): a short stream instead, for make test's run of each benchmark.
 int main(int argc, char** argv) {
-  if (argc >= 2 && std::strcmp(argv[1], "--smoke") == 0) {
-    g_smoke = true;
-    argv[1] = argv[0];
-    ++argv, --argc;
-  }
-  benchmark::Initialize(&argc, argv);
-  benchmark::RunSpecifiedBenchmarks();
-  return 0;
+  g_smoke = rigcal::perf::take_smoke_flag(argc, argv);
+  return rigcal::perf::run_benchmarks(argc, argv);
 }

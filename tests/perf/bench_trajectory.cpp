@@ -12,6 +12,7 @@
 #include "rigcal/bench/evaluate.h"
 #include "rigcal/io/files.h"
 #include "rigcal/io/trajectory_io.h"
+#include "smoke.h"
 
 namespace {
 
@@ -88,12 +89,6 @@ int main(int argc, char** argv) {
     fmt::print("wrote {}/gt.txt and {}/est.txt, {} poses each\n", argv[2], argv[2], n);
     return 0;
   }
-  if (argc >= 2 && std::strcmp(argv[1], "--smoke") == 0) {
-    g_size_divisor = 100;
-    argv[1] = argv[0];
-    ++argv, --argc;
-  }
-  benchmark::Initialize(&argc, argv);
-  benchmark::RunSpecifiedBenchmarks();
-  return 0;
+  if (rigcal::perf::take_smoke_flag(argc, argv)) g_size_divisor = 100;
+  return rigcal::perf::run_benchmarks(argc, argv);
 }
