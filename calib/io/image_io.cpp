@@ -98,7 +98,7 @@ ImageHeader probe_image(std::string_view bytes) {
 }
 
 void check_image_size(const ImageHeader& h, const std::string& name) {
-  if (h.width > kMaxImageSide || h.height > kMaxImageSide || h.width * h.height > kMaxImagePixels) {
+  if (!within_image_limits(h.width, h.height)) {
     throw Error(
         fmt::format("{}: {} x {} px is larger than rigcal reads (at most {} px a side and {} Mpx)",
                     name, h.width, h.height, kMaxImageSide, kMaxImagePixels / 1000000));

@@ -19,6 +19,10 @@ std::string_view to_string(Bayer bayer);
 inline constexpr long long kMinImageSide = 16;
 inline constexpr long long kMaxImageSide = 32768;
 inline constexpr long long kMaxImagePixels = 100'000'000;
+// True when a width x height image is no larger than the limits above.
+inline bool within_image_limits(long long width, long long height) {
+  return width <= kMaxImageSide && height <= kMaxImageSide && width * height <= kMaxImagePixels;
+}
 
 // 8-bit gray. 16-bit images are scaled by 1/256; colour images converted with OpenCV's BGR
 // weights; a Bayer image (one channel) demosaiced (edge-aware) to gray. Throws rigcal::Error

@@ -20,8 +20,7 @@ const rig::Sensor& camera_named(const rig::Rig& rig, std::string_view name, size
   }
   // Images rigcal could not read back are not rendered (nor their memory spent).
   const long long width = camera->camera.width, height = camera->camera.height;
-  if (width > io::kMaxImageSide || height > io::kMaxImageSide ||
-      width * height > io::kMaxImagePixels) {
+  if (!io::within_image_limits(width, height)) {
     throw Error(fmt::format("{}: {} x {} px is larger than rigcal reads ({} Mpx); not simulated",
                             camera->name, width, height, io::kMaxImagePixels / 1000000));
   }
