@@ -56,14 +56,22 @@ void add_bench(CLI::App& app) {
       "--align", o->align,
       "se3 | sim3 | yaw | origin | none (default: se3 for rigcal and vbr, none for evo and kitti)");
   cmd->add_option("--align-first", o->align_first,
-                  "align on the first N matched poses only (0: all)");
+                  "align on the first N matched poses only (0: all)")
+      // CLI11 reads '' as 0 and -1 as a huge count into an unsigned: neither is a count.
+      ->check(CLI::Validator(
+          [](std::string& s) {
+            return !s.empty() && s.find_first_not_of("0123456789") == std::string::npos
+                       ? std::string()
+                       : "expected a count of poses (0: all), got '" + s + "'";
+          },
+          "COUNT"));
   cmd->add_option("--association", o->association,
                   "interpolate | nearest | one_to_one | index (default: the convention's)");
   cmd->add_option("--max-diff", o->max_diff, "nearest / one_to_one: largest stamp difference, s")
-      ->check(finite_number(false))
+      ->check(seconds_within(0))
       ->capture_default_str();
   cmd->add_option("--max-gap", o->max_gap, "interpolate: longest GT interval bridged, s")
-      ->check(finite_number(true))
+      ->check(seconds_within(1e-9))
       ->capture_default_str();
   cmd->add_option("--delta", o->delta, "RPE delta of the evo-style pairs")
       ->check(finite_number(true))

@@ -107,7 +107,11 @@ void add_calibrate(CLI::App& app) {
       "are unchanged (OUT/cache/). Exit 0 every step that ran is ok (published when all ran);\n"
       "2 a step failed on bad input; 3 a step is undetermined by the data: the other steps'\n"
       "results are kept, nothing is published (an earlier OUT/calib.yaml is removed).");
-  cmd->add_option("session", o->run.session, "the session folder, or a single recording")
+  cmd->add_option(
+         "session", o->run.session,
+         "the session folder, a single recording, or a ROS1 bag, a folder of bags or an Ouster "
+         "capture (CAPTURE.pcap + CAPTURE.json), converted on the fly into a temporary "
+         "recording under $TMPDIR")
       ->required();
   cmd->add_option("--out", o->out, "output folder")->required();
   cmd->add_option("--rig", o->rig, "prior rig (default: session.yaml's rig, or SESSION/rig.yaml)");

@@ -21,7 +21,8 @@ struct Options {
 
 io::ImageSet images(const Options& o) {
   if (!o.session.empty()) {
-    return io::read_session_images(io::recording_for(io::read_session(o.session), "cameras"));
+    return io::read_session_images(
+        io::recording_for(io::read_session(o.session, console_progress()), "cameras"));
   }
   if (o.cameras.empty()) throw Error("give --camera NAME=GLOB (once per camera) or --session DIR");
   std::vector<std::pair<std::string, std::vector<std::string>>> cams;
@@ -75,7 +76,7 @@ void add_cameras(CLI::App& app) {
   cmd->add_option("--camera", o->cameras, "NAME=GLOB, e.g. cam_l='left/*.png' (once per camera)");
   cmd->add_option("--session", o->session,
                   "a session (its stereo/ recording) or a recording with camera_left/ and "
-                  "camera_right/ (doc/session.md)");
+                  "camera_right/, or a bag, folder of bags or capture (doc/session.md)");
   cmd->add_option("--model", o->model, "pinhole-radtan | pinhole-radtan5 | pinhole-equidistant")
       ->capture_default_str();
   cmd->add_option("--rig", o->rig, "rig to update (default: a new rig of these cameras)");

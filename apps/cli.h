@@ -27,6 +27,20 @@ inline CLI::Validator finite_number(bool strict) {
       strict ? "POSITIVE" : "NON-NEGATIVE");
 }
 
+// Option checks for a span of seconds within [min_s, max_s] (finite; a span past 1e9 s, 31 years,
+// is no recording's and would leave rigcal::Time's range).
+inline CLI::Validator seconds_within(double min_s, double max_s = 1e9) {
+  return CLI::Validator(
+      [min_s, max_s](std::string& text) -> std::string {
+        double v = 0;
+        if (CLI::detail::lexical_cast(text, v) && std::isfinite(v) && v >= min_s && v <= max_s)
+          return {};
+        return "expected seconds from " + CLI::detail::to_string(min_s) + " to " +
+               CLI::detail::to_string(max_s) + ", got '" + text + "'";
+      },
+      "SECONDS");
+}
+
 // `rigcal rig validate|show|convert`
 void add_rig_validate(CLI::App& rig);
 void add_rig_show(CLI::App& rig);
@@ -45,6 +59,8 @@ void add_lidar_camera(CLI::App& app);
 // `rigcal calibrate`, `rigcal publish`
 void add_calibrate(CLI::App& app);
 void add_publish(CLI::App& app);
+// `rigcal convert`
+void add_convert(CLI::App& app);
 // `rigcal target print`
 void add_target_print(CLI::App& target);
 

@@ -47,7 +47,7 @@ void run(const Options& o) {
   hand_eye::StepInputs in;
   in.lidar = o.lidar, in.gnss = o.gnss, in.rig_source = o.rig;
   if (!o.session.empty()) {  // what the session names, unless given
-    const io::Session s = io::read_session(o.session);
+    const io::Session s = io::read_session(o.session, console_progress());
     if (in.lidar.empty()) in.lidar = s.odometry;
     if (in.gnss.empty()) in.gnss = s.gnss;
   }
@@ -80,9 +80,10 @@ void add_hand_eye(CLI::App& app) {
                   "GNSS/INS trajectory (T_enu_gnss; TUM, KITTI, EuRoC, OpenCalib), or a CSV of "
                   "fixes with a header (time, latitude, longitude, height, roll, pitch, yaw), on "
                   "its own clock");
-  cmd->add_option("--session", o->session,
-                  "a session or recording (doc/session.md): --lidar and --gnss from its "
-                  "session.yaml (odometry, gnss) or <motion>/gnss/, unless given");
+  cmd->add_option(
+      "--session", o->session,
+      "a session, recording, bag or folder of bags (doc/session.md): --lidar and --gnss from its "
+      "session.yaml (odometry, gnss) or <motion>/gnss/, unless given");
   cmd->add_option("--attitude", o->attitude,
                   "GNSS fixes CSV only: enu (R = Rz(yaw) Ry(pitch) Rx(roll), yaw from east, "
                   "counter-clockwise) or ned (heading from north, clockwise; body x forward, z "
@@ -111,17 +112,18 @@ void add_hand_eye(CLI::App& app) {
                   "weighed with its own noise level (default 0.3,1: short pairs catch a hand-held "
                   "rig's sway, 1 s pairs its turns)")
       ->delimiter(',')
+      ->check(seconds_within(0.001, 1e6))
       ->capture_default_str();
   cmd->add_option("--stride", o->stride_s,
                   "seconds between the starts of consecutive pairs (0: end to end); overlapping "
                   "pairs are not counted as independent in the covariance")
-      ->check(finite_number(false))
+      ->check(seconds_within(0, 1e6))
       ->capture_default_str();
   cmd->add_option(
          "--gnss-smoothing", o->gnss_smoothing_s,
          "each GNSS/INS pose from a local quadratic fit over the fixes within +- this many "
          "seconds (at least 5 of them; 0: the fixes as they are)")
-      ->check(finite_number(false))
+      ->check(seconds_within(0, 1e6))
       ->capture_default_str();
   cmd->add_option("--min-rotation", o->min_rotation_deg, "pairs rotating less are dropped (deg)")
       ->check(finite_number(false))

@@ -50,7 +50,8 @@ void run(Options o) {
     if (!o.images.empty() || !o.scans.empty())
       throw Error("give --session DIR, or --images GLOB and --scans GLOB, not both");
     in = lidar_camera::pairs_from_recording(
-        io::recording_for(io::read_session(o.session), "lidar_camera"), rig, o.step);
+        io::recording_for(io::read_session(o.session, console_progress()), "lidar_camera"), rig,
+        o.step);
   } else {
     if (o.images.empty() || o.scans.empty())
       throw Error("give --session DIR, or --images GLOB and --scans GLOB");
@@ -88,10 +89,11 @@ void add_lidar_camera(CLI::App& app) {
   cmd->add_option("--lidar", o->step.lidar, "the rig's LiDAR")->capture_default_str();
   cmd->add_option("--rig", o->rig, "rig with the camera's intrinsics; updated with --out")
       ->required();
-  cmd->add_option("--session", o->session,
-                  "a session (its lidar_camera/ recording) or a recording: camera_right/ "
-                  "(camera_left/ for cam_l) and ouster_points/, each data/ + timestamps.txt; "
-                  "pairs by stamp on the base clock (the rig's time offsets applied)");
+  cmd->add_option(
+      "--session", o->session,
+      "a session (its lidar_camera/ recording), a recording, a bag or folder of bags: "
+      "camera_right/ (camera_left/ for cam_l) and ouster_points/, each data/ + timestamps.txt; "
+      "pairs by stamp on the base clock (the rig's time offsets applied)");
   cmd->add_option("--max-dt", o->step.max_dt_s,
                   "--session: an image takes the nearest scan within this many seconds")
       ->check(finite_number(true) & CLI::Range(1e-6, 3600.0))

@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 
 #include "cli.h"
 #include "rigcal/core/error.h"
@@ -30,6 +31,7 @@ int main(int argc, char** argv) {
 
   rigcal::cli::add_calibrate(app);
   rigcal::cli::add_publish(app);
+  rigcal::cli::add_convert(app);
   CLI::App* rig = app.add_subcommand("rig", "Check, show and convert a calibration YAML");
   rig->require_subcommand(1);
   rigcal::cli::add_rig_validate(*rig);
@@ -56,6 +58,12 @@ int main(int argc, char** argv) {
     return e.status;
   } catch (const rigcal::Error& e) {
     std::fprintf(stderr, "rigcal: error: %s\n", one_line(e.what()).c_str());
+    return 2;
+  } catch (const std::filesystem::filesystem_error& e) {
+    // The file system refused (permissions, a link loop, a name too long, a full disk): the
+    // input or the place to write is at fault, not rigcal.
+    std::fprintf(stderr, "rigcal: error: %s: %s\n", one_line(e.path1().c_str()).c_str(),
+                 one_line(e.code().message().c_str()).c_str());
     return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rigcal: internal error: %s\n", one_line(e.what()).c_str());

@@ -14,6 +14,7 @@
 #include "rigcal/io/sim_config.h"
 #include "rigcal/io/target_yaml.h"
 #include "rigcal/io/trajectory_io.h"
+#include "rigcal/report/json.h"
 #include "rigcal/rig/rig_yaml.h"
 #include "sample_rig.h"
 
@@ -54,6 +55,8 @@ void run(const Options& o) {
     if (!o.force)
       throw Error(
           fmt::format("{}: exists and is not empty; choose a new folder or give --force", o.out));
+    io::refuse_replacing_inputs(out,
+                                {{"--config", o.config}, {"--rig", o.rig}, {"--target", o.target}});
   }
   // Everything goes to a temporary sibling, renamed into place at the end: a failed run leaves
   // nothing half-written.
@@ -91,7 +94,7 @@ void run(const Options& o) {
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     }
     io::write_files_atomic({{tmp / "truth.yaml", rig::rig_to_yaml(rig)},
-                            {tmp / "truth.json", truth.dump(2) + "\n"},
+                            {tmp / "truth.json", report::json_text(truth)},
                             {tmp / "target.yaml", io::target_to_yaml(config.target)},
                             {tmp / "session.yaml", io::simulated_session_yaml(parts)}});
     if (fs::exists(out, ec)) fs::remove_all(out);
@@ -121,6 +124,11 @@ void add_simulate(CLI::App& app) {
   cmd->add_option("--out", o->out, "output folder (new or empty)")->required();
   cmd->add_option("--what", o->what, "comma-separated parts")->capture_default_str();
   cmd->add_option("--seed", o->seed, "random seed (default 1, or the config's)")
+      ->check(CLI::Validator(
+          [](std::string& s) {
+            return s.empty() ? std::string("expected an integer, got ''") : "";
+          },
+          "INT"))
       ->each([o](const std::string&) { o->seed_given = true; });
   cmd->add_option("--config", o->config, "simulator settings (YAML; doc/simulator.md)");
   cmd->add_option("--target", o->target, "target YAML (default: the A3 checkerboard)");

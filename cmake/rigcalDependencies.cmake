@@ -15,6 +15,10 @@ endif()
 if(NOT TARGET PkgConfig::CAIRO)
   pkg_check_modules(CAIRO REQUIRED IMPORTED_TARGET cairo cairo-pdf)
 endif()
+# The Ouster capture reader (calib/io/ouster_pcap.cpp) reads pcap files through libpcap.
+if(NOT TARGET PkgConfig::PCAP)
+  pkg_check_modules(PCAP REQUIRED IMPORTED_TARGET libpcap)
+endif()
 find_dependency(TBB)
 find_dependency(apriltag)
 # The image reader decodes JPEG itself and checks PNG chunk CRCs (calib/io/image_io.cpp).
@@ -31,4 +35,31 @@ if(NOT TARGET rigcal_mrcal)
   add_library(rigcal_mrcal UNKNOWN IMPORTED)
   set_target_properties(rigcal_mrcal PROPERTIES IMPORTED_LOCATION ${MRCAL_LIBRARY}
                         INTERFACE_INCLUDE_DIRECTORIES ${MRCAL_INCLUDE_DIR})
+endif()
+
+# ROS1 bags without ROS (calib/io/bag.cpp): Debian's librosbag-storage-dev. Its CMake package
+# configures only with /usr/bin first on PATH and misses link libraries, and there is no
+# pluginlib.pc: one imported target of our own, from the headers and libraries themselves.
+if(NOT TARGET rigcal_rosbag)
+  find_path(ROSBAG_INCLUDE_DIR rosbag/bag.h)
+  set(ROSBAG_LIBRARIES)
+  foreach(lib rosbag_storage roscpp_serialization rostime cpp_common console_bridge boost_filesystem)
+    find_library(ROSBAG_LIB_${lib} ${lib})
+    if(NOT ROSBAG_LIB_${lib})
+      message(FATAL_ERROR "lib${lib} not found: install Debian's librosbag-storage-dev (make deps does)")
+    endif()
+    list(APPEND ROSBAG_LIBRARIES ${ROSBAG_LIB_${lib}})
+  endforeach()
+  if(NOT ROSBAG_INCLUDE_DIR)
+    message(FATAL_ERROR "rosbag/bag.h not found: install Debian's librosbag-storage-dev (make deps does)")
+  endif()
+  set(ROSBAG_INCLUDE_DIRS ${ROSBAG_INCLUDE_DIR})
+  foreach(d pluginlib class_loader rcutils rcpputils ament_index_cpp)
+    if(IS_DIRECTORY ${ROSBAG_INCLUDE_DIR}/${d})
+      list(APPEND ROSBAG_INCLUDE_DIRS ${ROSBAG_INCLUDE_DIR}/${d})
+    endif()
+  endforeach()
+  add_library(rigcal_rosbag INTERFACE IMPORTED)
+  set_target_properties(rigcal_rosbag PROPERTIES INTERFACE_INCLUDE_DIRECTORIES "${ROSBAG_INCLUDE_DIRS}"
+                        INTERFACE_LINK_LIBRARIES "${ROSBAG_LIBRARIES}")
 endif()

@@ -8,6 +8,7 @@
 #include "rigcal/core/error.h"
 #include "rigcal/core/version.h"
 #include "rigcal/io/files.h"
+#include "rigcal/report/json.h"
 #include "rigcal/report/svg_plot.h"
 
 namespace rigcal::bench {
@@ -98,7 +99,7 @@ void write_bench_report(const EvalResult& r, const fs::path& dir,
   report::PlotSeries e{"ATE", {}, r.ate_trans_errors, {}};
   for (const Time& t : r.stamps) e.x.push_back((t - r.stamps.front()).seconds());
   along.series = {e};
-  io::write_files_atomic({{dir / "bench.json", bench_json(r, inputs).dump(2) + "\n"},
+  io::write_files_atomic({{dir / "bench.json", report::json_text(bench_json(r, inputs))},
                           {dir / "trajectory_top.svg", report::render_svg(top)},
                           {dir / "ate_along.svg", report::render_svg(along)}});
 }
@@ -251,7 +252,7 @@ void write_leaderboard_report(const Leaderboard& b, const fs::path& dir) {
   }
   io::write_files_atomic({{dir / "leaderboard.md", leaderboard_markdown(b)},
                           {dir / "leaderboard.csv", leaderboard_csv(b)},
-                          {dir / "leaderboard.json", leaderboard_json(b).dump(2) + "\n"},
+                          {dir / "leaderboard.json", report::json_text(leaderboard_json(b))},
                           {dir / "cumulative_ate.svg", report::render_svg(ate)},
                           {dir / "cumulative_rpe.svg", report::render_svg(rpe)}});
 }

@@ -16,6 +16,7 @@
 #include "rigcal/core/stats.h"
 #include "rigcal/io/files.h"
 #include "rigcal/io/target_yaml.h"
+#include "rigcal/report/json.h"
 #include "rigcal/rig/rig_yaml.h"
 
 namespace rigcal::camera {
@@ -214,7 +215,7 @@ report::StepResult calibrate_cameras(const StepInputs& in, const StepOptions& o,
   for (const auto& [c, f] : d.jobs)
     all_images.push_back(in.images.files[c][f]), all_detections.push_back(d.cameras[c].frames[f]);
   out.report_files.push_back({"corners.vnl", corners_vnl(target, all_images, all_detections)});
-  out.report_files.push_back({"cameras.json", out.report.dump(2) + "\n"});
+  out.report_files.push_back({"cameras.json", report::json_text(out.report)});
   report::finish_report(out, "cameras.json");
   for (size_t c = 0; c < n_cams; ++c) {
     const int w = d.cameras[c].width, h = d.cameras[c].height;

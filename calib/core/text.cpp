@@ -49,6 +49,15 @@ size_t utf8_sequence(std::string_view s, size_t i) {
 }
 }  // namespace
 
+size_t first_invalid_utf8(std::string_view text) {
+  for (size_t i = 0; i < text.size();) {
+    const size_t n = static_cast<unsigned char>(text[i]) < 0x80 ? 1 : utf8_sequence(text, i);
+    if (n == 0) return i;
+    i += n;
+  }
+  return std::string_view::npos;
+}
+
 std::string printable(std::string_view text, size_t max_chars) {
   std::string out;
   size_t chars = 0;

@@ -27,6 +27,10 @@ std::string_view trim(std::string_view s);
 // `max_chars` cut with "...". A message never ends in a raw invalid byte or spans lines.
 std::string printable(std::string_view text, size_t max_chars = 80);
 
+// The offset of the first byte that is not part of well-formed UTF-8 (overlong forms, surrogates
+// and cut sequences are not), npos when all of `text` is UTF-8.
+size_t first_invalid_utf8(std::string_view text);
+
 struct TextLine {
   std::string_view text;  // trimmed
   int number;             // 1-based

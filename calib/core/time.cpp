@@ -13,10 +13,11 @@ namespace rigcal {
 namespace {
 
 using i128 = __int128;
-constexpr i128 kMaxNs = std::numeric_limits<int64_t>::max();
+constexpr i128 kMaxNs = kMaxReadNs;
+constexpr std::string_view kRange = "a time within +-146 years of 1970 (below 2^62 ns)";
 
 [[noreturn]] void bad(std::string_view what, std::string_view text, std::string_view expected) {
-  throw Error(fmt::format("{}: expected {}, got '{}'", what, expected, text));
+  throw Error(fmt::format("{}: expected {}, got '{}'", what, expected, printable(text)));
 }
 
 bool is_digit(char c) { return c >= '0' && c <= '9'; }
@@ -52,13 +53,13 @@ Decimal parse_decimal(std::string_view s, std::string_view what, std::string_vie
   return d;
 }
 
-// Rounds digits * 10^exp10 to an integer (half away from zero); throws when out of int64 range.
+// Rounds digits * 10^exp10 to an integer (half away from zero); throws beyond +-kMaxNs.
 int64_t round_decimal(const Decimal& d, std::string_view what, std::string_view text) {
   size_t first = d.digits.find_first_not_of('0');
   if (first == std::string::npos) return 0;
   const std::string_view digits = std::string_view(d.digits).substr(first);
   i128 value = 0;
-  auto out_of_range = [&] { bad(what, text, "a time within +-292 years"); };
+  auto out_of_range = [&] { bad(what, text, kRange); };
   const long keep = static_cast<long>(digits.size()) + d.exp10;  // digits left of the point
   if (keep > 19 + 1) out_of_range();
   for (long k = 0; k < keep; ++k) {
@@ -76,8 +77,8 @@ int64_t round_decimal(const Decimal& d, std::string_view what, std::string_view 
 
 Time Time::from_seconds(double seconds) {
   const double ns = std::round(seconds * 1e9);
-  if (!std::isfinite(ns) || std::abs(ns) > 9.2e18) {
-    throw Error(fmt::format("time {} s is out of the representable range (+-292 years)", seconds));
+  if (!std::isfinite(ns) || std::abs(ns) >= std::ldexp(1.0, 62)) {
+    throw Error(fmt::format("time {} s is out of the range read (+-146 years)", seconds));
   }
   return Time{static_cast<int64_t>(ns)};
 }
@@ -95,7 +96,9 @@ Time parse_nanoseconds(std::string_view text, std::string_view what) {
       bad(what, text, "an integer count of nanoseconds");
     }
   }
-  return Time{parse_int(s, what)};
+  const Time t{parse_int(s, what)};
+  if (t.ns > kMaxNs || t.ns < -kMaxNs) bad(what, text, kRange);
+  return t;
 }
 
 Time parse_iso8601(std::string_view text, std::string_view what) {
@@ -147,7 +150,7 @@ Time parse_iso8601(std::string_view text, std::string_view what) {
   const i128 total_s =
       static_cast<i128>(days) * 86400 + hour * 3600 + minute * 60 + second - offset_s;
   const i128 ns = total_s * 1000000000 + round_decimal(frac, what, text);
-  if (ns > kMaxNs || ns < -kMaxNs) bad(what, text, "a time within +-292 years of 1970");
+  if (ns > kMaxNs || ns < -kMaxNs) bad(what, text, kRange);
   return Time{static_cast<int64_t>(ns)};
 }
 

@@ -2,6 +2,8 @@
 // The one time type of rigcal: a signed count of nanoseconds (int64, +-292 years).
 // Used both for instants (stamps on some clock) and for spans between them. Text is parsed
 // exactly, digit by digit, never through a double: "1403715529.112143517" keeps every digit.
+// Every time read (text or seconds) lies within +-kMaxReadNs, half the type's range, so the sum
+// or the difference of any two read times is representable.
 #include <compare>
 #include <cstdint>
 #include <string>
@@ -9,11 +11,14 @@
 
 namespace rigcal {
 
+// 2^62 - 1 ns: +-146 years of 1970 (1824 to 2116), as stamps and as spans.
+inline constexpr int64_t kMaxReadNs = (int64_t{1} << 62) - 1;
+
 struct Time {
   int64_t ns = 0;
 
   static constexpr Time from_ns(int64_t ns) { return Time{ns}; }
-  // Rounds to the nearest nanosecond. Throws rigcal::Error when out of the int64 range.
+  // Rounds to the nearest nanosecond. Throws rigcal::Error beyond +-kMaxReadNs.
   static Time from_seconds(double seconds);
   double seconds() const { return static_cast<double>(ns) * 1e-9; }
 
@@ -23,6 +28,7 @@ struct Time {
   constexpr Time operator-() const { return Time{-ns}; }
 };
 
+// The parsers below throw rigcal::Error beyond +-kMaxReadNs.
 // Decimal seconds, exact: "366.660458140", "-0.5", "1.403715529112143517e+09". Digits beyond the
 // nanosecond are rounded half away from zero. Throws rigcal::Error naming `what`.
 Time parse_seconds(std::string_view text, std::string_view what = "time");

@@ -93,7 +93,7 @@ std::vector<io::OutputFile> hand_eye_report_files(const std::filesystem::path& d
                   {"outlier", static_cast<bool>(r.outlier[k])}});
   }
   j["pairs"] = pj;
-  files.push_back({dir / "hand_eye.json", j.dump(2) + "\n"});
+  files.push_back({dir / "hand_eye.json", report::json_text(j)});
   // Residuals over time.
   report::Plot p;
   p.title = "Per-pair residuals after the solve";

@@ -12,6 +12,7 @@
 #include "rigcal/core/version.h"
 #include "rigcal/hand_eye/report.h"
 #include "rigcal/io/gnss_fixes.h"
+#include "rigcal/report/json.h"
 
 namespace rigcal::hand_eye {
 namespace {
@@ -52,7 +53,7 @@ report::StepResult undetermined(report::StepResult out, const StepInputs& in, st
       {"inputs",
        {{"lidar", in.lidar.string()}, {"gnss", in.gnss.string()}, {"rig", in.rig_source}}},
       {"notes", out.notes}};
-  out.report_files = {{"hand_eye.json", j.dump(2) + "\n"}};
+  out.report_files = {{"hand_eye.json", report::json_text(j)}};
   report::finish_report(out, "hand_eye.json");
   return out;
 }

@@ -5,6 +5,7 @@
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cstring>
@@ -101,21 +102,57 @@ void write_file_atomic(const fs::path& path, const std::string& content) {
   write_files_atomic({{path, content}});
 }
 
+namespace {
+// A path resolved as far as it can be (a link loop or a missing folder leaves it as written,
+// made absolute).
+fs::path resolved(const fs::path& p) {
+  std::error_code ec;
+  const fs::path r = fs::weakly_canonical(p, ec);
+  return ec ? fs::absolute(p, ec).lexically_normal() : r;
+}
+}  // namespace
+
 void refuse_outputs_over_inputs(const std::vector<OutputFile>& outputs,
                                 const std::vector<std::pair<std::string, fs::path>>& inputs) {
   for (const OutputFile& out : outputs) {
+    if (out.path.empty()) continue;
     for (const auto& [what, in] : inputs) {
       if (in.empty()) continue;
-      std::error_code ec;
-      const bool same = fs::exists(out.path, ec) && fs::exists(in, ec)
-                            ? fs::equivalent(out.path, in, ec)
-                            : fs::weakly_canonical(out.path, ec) == fs::weakly_canonical(in, ec);
+      std::error_code ec, ec_in;
+      const bool same = fs::exists(out.path, ec) && fs::exists(in, ec_in) && !ec && !ec_in
+                            ? fs::equivalent(out.path, in, ec) && !ec
+                            : resolved(out.path) == resolved(in);
       if (same) {
         throw Error(
             fmt::format("{}: is an input ({}); the output would destroy it: choose "
                         "another output",
                         out.path.string(), what));
       }
+    }
+  }
+}
+
+void refuse_replacing_inputs(const fs::path& folder,
+                             const std::vector<std::pair<std::string, fs::path>>& inputs) {
+  std::error_code ec;
+  // a lies at or below b.
+  auto within = [](const fs::path& a, const fs::path& b) {
+    auto [ia, ib] = std::mismatch(a.begin(), a.end(), b.begin(), b.end());
+    return ib == b.end() || (std::next(ib) == b.end() && ib->empty());
+  };
+  const fs::path f = resolved(folder);
+  if (within(resolved(fs::current_path(ec)), f)) {
+    throw Error(
+        fmt::format("{}: holds the current folder; replacing it would remove it: choose "
+                    "another output folder",
+                    folder.string()));
+  }
+  for (const auto& [what, in] : inputs) {
+    if (!in.empty() && within(resolved(in), f)) {
+      throw Error(
+          fmt::format("{}: holds an input ({}, {}); replacing it would remove it: choose "
+                      "another output folder",
+                      folder.string(), what, in.string()));
     }
   }
 }

@@ -28,6 +28,12 @@ void refuse_outputs_over_inputs(
     const std::vector<OutputFile>& outputs,
     const std::vector<std::pair<std::string, std::filesystem::path>>& inputs);
 
+// Throws rigcal::Error when replacing `folder` (removing what it holds) would remove an input or
+// the working folder: `folder` is the current folder or one above it, or holds one of `inputs`.
+void refuse_replacing_inputs(
+    const std::filesystem::path& folder,
+    const std::vector<std::pair<std::string, std::filesystem::path>>& inputs);
+
 // An exclusive claim on an output folder for one run (flock on the folder itself, so nothing is
 // left behind; released when the object ends, or the process does). Two runs writing the same
 // folder at once would leave a mixture of their files: the second is refused with a

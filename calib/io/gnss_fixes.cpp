@@ -141,6 +141,11 @@ GnssFixes parse_gnss_fixes(std::string_view text, std::string_view file_name, At
       fail_at(file_name, number, "",
               fmt::format("latitude {} / longitude {} out of range (degrees expected)", lat, lon));
     }
+    // A receiver on a rig: between the deepest mine and the edge of space.
+    if (!(h >= -12000 && h <= 100000)) {
+      fail_at(file_name, number, "",
+              fmt::format("height {} m outside -12 km to 100 km (ellipsoidal metres expected)", h));
+    }
     if (out.T_enu_gnss.stamps.empty()) {
       out.origin = origin.value_or(GeodeticOrigin{lat, lon, h});
       enu.Reset(out.origin.latitude_deg, out.origin.longitude_deg, out.origin.height_m);

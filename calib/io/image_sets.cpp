@@ -73,12 +73,20 @@ StampedFolder read_stamped_folder(const fs::path& folder, const std::string& ext
   const fs::path stamps = folder / "timestamps.txt";
   const std::string text = read_text_file(stamps);
   for (const TextLine& line : data_lines(text, nullptr)) {
+    Time t;
     try {
-      out.stamps.push_back(parse_time(line.text));
-    } catch (const Error&) {
-      fail_at(stamps.string(), line.number, "",
-              fmt::format("expected a time, got '{}'", line.text));
+      t = parse_time(line.text);
+    } catch (const Error& e) {
+      fail_at(stamps.string(), line.number, "", e.what());
     }
+    // The files pair with the stamps in order, so the stamps must be in order too.
+    if (!out.stamps.empty() && t <= out.stamps.back()) {
+      fail_at(stamps.string(), line.number, "",
+              fmt::format("stamp {} is not after the previous line's ({}); a topic's frames are "
+                          "stamped in increasing order",
+                          to_seconds_text(t), to_seconds_text(out.stamps.back())));
+    }
+    out.stamps.push_back(t);
   }
   if (out.stamps.size() != out.files.size()) {
     throw Error(fmt::format("{}: {} stamps in timestamps.txt for {} {} files in data/",

@@ -27,7 +27,8 @@ std::optional<long> frame_number(const std::string& path);
 ImageSet pair_by_frame_number(
     const std::vector<std::pair<std::string, std::vector<std::string>>>& cameras);
 // A session folder in the vbr-devkit layout: data/*<extension> (sorted) and timestamps.txt, one
-// stamp a line (ISO-8601 or seconds) for each file. Throws rigcal::Error when the counts differ.
+// stamp a line (ISO-8601 or seconds) for each file, strictly increasing. Throws rigcal::Error
+// naming the line for a stamp not read or not after the previous one, and when the counts differ.
 struct StampedFolder {
   std::vector<std::string> files;
   std::vector<Time> stamps;

@@ -78,7 +78,7 @@ std::vector<Field> vbr_fields(const std::filesystem::path& bin, size_t& point_st
   if (!std::filesystem::exists(meta)) return {};
   nlohmann::json j;
   try {
-    j = nlohmann::json::parse(read_text_file(meta));
+    j = nlohmann::json::parse(read_text_file(meta, kMaxMetadataBytes));
   } catch (const std::exception& e) {
     throw Error(fmt::format("{}: not JSON ({})", meta.string(), e.what()));
   }

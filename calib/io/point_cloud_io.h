@@ -7,10 +7,15 @@
 // rigcal reads PCD itself rather than through PCL: the two layouts are a page of code, and PCL's
 // io pulls 300 Debian packages into a clean install.
 #include <Eigen/Core>
+#include <cstddef>
 #include <filesystem>
 #include <vector>
 
 namespace rigcal::io {
+
+// A topic's .metadata.json is a few hundred bytes (the fields of one message type); a larger one
+// is refused before it is parsed.
+inline constexpr size_t kMaxMetadataBytes = 1 << 20;
 
 // By extension: .bin (KITTI) or .pcd. Throws rigcal::Error naming the file and what is wrong.
 std::vector<Eigen::Vector3d> read_point_cloud(const std::filesystem::path& path);

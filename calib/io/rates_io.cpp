@@ -268,4 +268,12 @@ RateFile read_rates(const fs::path& path, const RateReadOptions& opt) {
   return out;
 }
 
+std::vector<fs::path> rate_files(const fs::path& path) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) return {path / "timestamps.txt", path / "data" / "imu.txt"};
+  if (path.parent_path().filename() == "data")
+    return {path, path.parent_path().parent_path() / "timestamps.txt"};
+  return {path};
+}
+
 }  // namespace rigcal::io

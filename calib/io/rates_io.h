@@ -33,6 +33,10 @@ struct RateFile {
 // Throws rigcal::Error naming the file and line on bad input.
 RateFile read_rates(const std::filesystem::path& path, const RateReadOptions& options = {});
 
+// The files read_rates reads for `path`: a vbr-devkit folder's timestamps.txt and data/imu.txt;
+// a file itself, with its folder's timestamps.txt when it is a devkit data/imu.txt.
+std::vector<std::filesystem::path> rate_files(const std::filesystem::path& path);
+
 RateReadOptions::Format rate_format_from_string(
     std::string_view name);  // auto|vbr|table|trajectory
 

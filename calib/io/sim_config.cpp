@@ -22,6 +22,7 @@ using Setter = std::function<void(const YAML::Node&)>;
 
 void apply_sim_config(std::string_view text, std::string_view file, sim::SimConfig& c) {
   const YAML::Node root = io::load_yaml(text, file);
+  io::refuse_duplicate_keys(root, file);
   if (root.IsNull()) return;
   const std::filesystem::path base = std::filesystem::path(std::string(file)).parent_path();
   std::string key_now;

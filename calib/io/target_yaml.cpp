@@ -15,6 +15,7 @@ namespace rigcal::io {
 
 camera::Target parse_target_yaml(std::string_view text, std::string_view file) {
   const YAML::Node root = io::load_yaml(text, file);
+  io::refuse_duplicate_keys(root, file);
   if (!root.IsMap()) fail_at(file, 0, "", "expected a map with target_type");
   auto line = [](const YAML::Node& n) { return yaml_line(n); };
   auto get = [&](const char* key) -> YAML::Node {

@@ -214,6 +214,12 @@ TrajectoryFile parse_trajectory(std::string_view text, std::string_view file_nam
       case TrajectoryFormat::automatic:
         break;
     }
+    // Beyond any trajectory (the Moon is 4e8 m away); squares of such numbers overflow.
+    if (!(T.t.cwiseAbs().maxCoeff() <= kMaxTrajectoryPosition_m)) {
+      fail_at(file_name, line.number, "",
+              fmt::format("position ({}, {}, {}) m lies beyond {:g} m from the origin", T.t.x(),
+                          T.t.y(), T.t.z(), kMaxTrajectoryPosition_m));
+    }
     if (out.format != TrajectoryFormat::kitti && !traj.stamps.empty() &&
         stamp <= traj.stamps.back()) {
       using D = TrajectoryReadOptions::Duplicates;

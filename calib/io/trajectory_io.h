@@ -15,6 +15,9 @@
 
 namespace rigcal::io {
 
+// Every position read lies within this many metres of the origin on each axis.
+inline constexpr double kMaxTrajectoryPosition_m = 1e9;
+
 enum class TrajectoryFormat { automatic, tum, kitti, euroc, opencalib };
 // auto|tum|kitti|euroc|opencalib
 TrajectoryFormat trajectory_format_from_string(std::string_view name);

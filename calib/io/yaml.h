@@ -19,6 +19,9 @@ inline constexpr int kMaxYamlDepth = 200;
 // Throws rigcal::Error "FILE:LINE: YAML syntax error: ..." on malformed text, and when the text or
 // its expansion is over the limits above.
 YAML::Node load_yaml(std::string_view text, std::string_view file_name);
+// Throws rigcal::Error "FILE:LINE: key 'K': given twice" for a key repeated in any map of the
+// tree (yaml-cpp keeps one of them silently).
+void refuse_duplicate_keys(const YAML::Node& node, std::string_view file_name);
 // 1-based line of a node, 0 when unknown.
 int yaml_line(const YAML::Node& node);
 

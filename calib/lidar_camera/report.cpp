@@ -108,7 +108,7 @@ std::vector<io::OutputFile> lidar_camera_report_files(const std::filesystem::pat
     pj.push_back(p);
   }
   j["pairs"] = pj;
-  std::vector<io::OutputFile> files{{dir / "lidar_camera.json", j.dump(2) + "\n"}};
+  std::vector<io::OutputFile> files{{dir / "lidar_camera.json", report::json_text(j)}};
   for (size_t k = 0; k < pairs.size() && k < images.size(); ++k) {
     files.push_back({dir / fmt::format("pair_{:02d}.png", k + 1),
                      report::encode_png(

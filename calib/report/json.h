@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "rigcal/core/se3.h"
 
@@ -21,6 +22,12 @@ inline nlohmann::json pose_json(const SE3& T) {
   nlohmann::json rows = nlohmann::json::array();
   for (int r = 0; r < 4; ++r) rows.push_back({m(r, 0), m(r, 1), m(r, 2), m(r, 3)});
   return rows;
+}
+
+// The file text of a JSON document: indented by 2, a final newline, and any invalid UTF-8 in its
+// strings (names and messages quoted from damaged input) written as U+FFFD instead of throwing.
+inline std::string json_text(const nlohmann::json& j) {
+  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 }  // namespace rigcal::report

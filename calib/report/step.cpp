@@ -4,6 +4,8 @@
 
 #include <stdexcept>
 
+#include "rigcal/report/json.h"
+
 namespace rigcal::report {
 
 std::string_view to_string(StepStatus status) {
@@ -19,7 +21,7 @@ void finish_report(StepResult& r, std::string_view json_file) {
       r.report["reason"] = r.reason;
       r.report["remedy"] = r.remedy;
     }
-    f.content = r.report.dump(2) + "\n";
+    f.content = json_text(r.report);
     return;
   }
   throw std::logic_error(fmt::format("{}: no {} among its report files", r.step, json_file));

@@ -13,6 +13,7 @@
 #include "rigcal/io/files.h"
 #include "rigcal/io/image_sets.h"
 #include "rigcal/io/session.h"
+#include "rigcal/report/json.h"
 #include "rigcal/rig/rig_yaml.h"
 #include "rigcal/session/provenance.h"
 
@@ -338,7 +339,7 @@ CalibrateResult calibrate(const CalibrateOptions& o, const Progress& progress) {
   if (!o.from.empty() && !o.only.empty()) throw Error("give --from or --only, not both");
   if (o.out.empty()) throw Error("--out: the output folder is needed");
   const io::FolderLock claim(o.out);
-  const io::Session s = io::read_session(o.session);
+  const io::Session s = io::read_session(o.session, progress);
   const fs::path rig_file = o.rig.empty() ? s.rig : o.rig;
   if (rig_file.empty()) {
     throw Error(fmt::format(
@@ -394,6 +395,7 @@ CalibrateResult calibrate(const CalibrateOptions& o, const Progress& progress) {
       try {
         for (const auto& [role, path] : p.inputs) {
           hashed.push_back(hash_input(role, path));
+          hashed.back().path = io::source_path(s, hashed.back().path);  // a bag's, not /tmp's
           tell("hashing the inputs", hashed.size(), p.inputs.size());
         }
         Sha256 k;
@@ -460,7 +462,7 @@ CalibrateResult calibrate(const CalibrateOptions& o, const Progress& progress) {
         write_report_folder(report_dir, r.report_files);
         nlohmann::json cache = cache_json(key, run, step_rig, wrote, hashed);
         if (p.reuse_detections) cache["detections_key"] = detections_key(hashed, o);
-        io::write_file_atomic(cache_file, cache.dump(2) + "\n");
+        io::write_file_atomic(cache_file, report::json_text(cache));
       } catch (const std::exception& e) {
         // Bad input fails the step; anything else is a bug, said as one; the run goes on.
         const bool bad_input = dynamic_cast<const Error*>(&e) != nullptr;

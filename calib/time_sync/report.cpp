@@ -106,7 +106,7 @@ std::vector<io::OutputFile> time_sync_report_files(
     const std::filesystem::path& dir, const TimeSyncResult& r, const TimeSyncOptions& o,
     const TimeSyncInputs& in, const AngularRates& reference, const AngularRates& other) {
   std::vector<io::OutputFile> files;
-  files.push_back({dir / "time_sync.json", time_sync_json(r, o, in).dump(2) + "\n"});
+  files.push_back({dir / "time_sync.json", report::json_text(time_sync_json(r, o, in))});
   {
     report::Plot p;
     p.title = "Normalized correlation of |w| against the offset";

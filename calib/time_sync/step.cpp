@@ -3,10 +3,14 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <limits>
 
 #include "rigcal/core/error.h"
 #include "rigcal/core/se3.h"
 #include "rigcal/core/text.h"
+#include "rigcal/io/files.h"
+#include "rigcal/io/session.h"
+#include "rigcal/rig/rig_yaml.h"
 #include "rigcal/time_sync/report.h"
 
 namespace rigcal::time_sync {
@@ -22,6 +26,77 @@ StepInputs streams_of_recording(const fs::path& recording) {
   in.other.path = dir / "imu";
   in.other.sensor = "imu";
   return in;
+}
+
+namespace {
+
+io::RateReadOptions read_options(const std::string& format, const std::string& columns,
+                                 const char* what) {
+  io::RateReadOptions ro;
+  try {
+    ro.format = io::rate_format_from_string(format);
+  } catch (const Error& e) {
+    throw Error(fmt::format("--{}-format: {}", what, e.what()));
+  }
+  ro.columns = columns;
+  if (!columns.empty() && ro.format == io::RateReadOptions::Format::automatic)
+    ro.format = io::RateReadOptions::Format::table;
+  return ro;
+}
+
+TimeSyncOptions sync_options(const ClockRequest& o) {
+  TimeSyncOptions t;
+  if (o.max_offset == "all") {
+    t.max_offset_s = std::numeric_limits<double>::infinity();
+  } else {
+    try {
+      t.max_offset_s = parse_double(o.max_offset, "--max-offset");
+    } catch (const Error&) {
+      t.max_offset_s = 0;
+    }
+    if (!(t.max_offset_s > 0))
+      throw Error(
+          fmt::format("--max-offset: expected seconds > 0 or 'all', got '{}'", o.max_offset));
+  }
+  if (!(o.min_overlap > 0 && o.min_overlap <= 1))
+    throw Error(fmt::format("--min-overlap: expected a fraction in (0, 1], got {}", o.min_overlap));
+  // Below a second a window holds too few samples to correlate (and 1e-320 s would be 1e320 of
+  // them).
+  if (!(o.window_s == 0 || (o.window_s >= 1 && std::isfinite(o.window_s))))
+    throw Error(
+        fmt::format("--window: expected 0 (automatic) or at least 1 s, got {}", o.window_s));
+  t.min_overlap = o.min_overlap;
+  t.window_s = o.window_s;
+  t.min_excitation_rad_s = o.min_excitation;
+  t.three_axis = !o.no_three_axis;
+  return t;
+}
+
+}  // namespace
+
+ClockRun resolve_clock_request(const ClockRequest& o) {
+  ClockRun run;
+  StepInputs& in = run.inputs;
+  if (!o.session.empty())
+    in = streams_of_recording(io::recording_for(io::read_session(o.session), "motion"));
+  if (!o.reference.empty()) in.reference.path = o.reference;
+  if (!o.other.empty()) in.other.path = o.other;
+  if (!o.sensor.empty()) in.other.sensor = o.sensor;
+  if (!o.reference_sensor.empty()) in.reference.sensor = o.reference_sensor;
+  if (in.reference.path.empty() || in.other.path.empty())
+    throw Error("give --reference and --other (IMU logs or trajectories), or --session DIR");
+  if (!o.out.empty() && (o.rig.empty() || in.other.sensor.empty()))
+    throw Error("--out writes the time_offset of --sensor into --rig: give both");
+  run.options = sync_options(o);
+  in.reference.read = read_options(o.reference_format, o.reference_columns, "reference");
+  in.other.read = read_options(o.other_format, o.other_columns, "other");
+  std::vector<std::pair<std::string, fs::path>> files_read;
+  for (const auto& [what, stream] :
+       {std::pair{"--reference", &in.reference}, {"--other", &in.other}})
+    for (const fs::path& f : io::rate_files(stream->path)) files_read.emplace_back(what, f);
+  io::refuse_outputs_over_inputs({{o.out, ""}}, files_read);
+  if (!o.rig.empty()) in.rig = rig::read_rig_file(o.rig);
+  return run;
 }
 
 report::StepResult estimate_clock(const StepInputs& in, const TimeSyncOptions& topt,

@@ -31,6 +31,27 @@ struct StepInputs {
 // sensor os_imu, on the base clock) as the reference and the external IMU (imu/, sensor imu).
 StepInputs streams_of_recording(const std::filesystem::path& recording);
 
+// What `rigcal time-offset` is asked, as the command line gives it: explicit streams, or a session
+// whose motion recording gives both (each unless given).
+struct ClockRequest {
+  std::string reference, other, session, sensor, reference_sensor, rig, out, report;
+  std::string reference_format = "auto", other_format = "auto";
+  std::string reference_columns, other_columns;  // a table's columns; a table when given
+  std::string max_offset = "1";                  // seconds, or "all"
+  double min_overlap = 0.5, window_s = 0.0, min_excitation = 0.05;
+  bool no_three_axis = false;
+};
+
+struct ClockRun {
+  StepInputs inputs;  // the rig read when the request names one
+  TimeSyncOptions options;
+};
+
+// Checks the request and resolves it: the session read, an output that is one of the files the
+// step reads refused (--rig may be --out), the rig read first so that a bad one fails fast.
+// Throws rigcal::Error naming the option on a bad value or a missing stream.
+ClockRun resolve_clock_request(const ClockRequest& request);
+
 // Status undetermined when the data give no offset (not enough excitation, ambiguous, no overlap,
 // poor correlation): the report is made, the rig is returned unchanged. Throws rigcal::Error on
 // bad input (unreadable streams, sensors missing from the rig).

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Writes the hand-made seeds of tests/fuzz/corpus/ (small valid inputs of each format, the binary
 ones included). Run from anywhere: python3 tests/fuzz/make_seeds.py. The real files (data/,
-targets/, the shared fixtures) are added at run time by run_fuzz.sh, not copied here."""
+targets/, the shared fixtures) are added at run time by run_fuzz.sh, not copied here. The bag and
+ROS message seeds are written by make_bag_seeds.py (Debian's Python with python3-rosbag)."""
 import os
 import struct
 
@@ -105,3 +106,97 @@ seed("corners_vnl", "two_images.vnl", "\n".join(lines) + "\n")
 seed("session", "every_key.yaml", "cameras: stereo\nlidar_camera: lidar_camera\nmotion: motion\n"
      "target: target.yaml\nrig: rig.yaml\nodometry: motion/gnss/poses.tum\ngnss: motion/gnss/poses.tum\n")
 seed("session", "defaults.yaml", "# every purpose found by default\n")
+
+import zlib
+
+
+def png(width, height, bit_depth, color_type, channels, palette=None):
+    """A valid PNG of a gradient (filter 0 rows), written with zlib."""
+    def chunk(kind, body):
+        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
+    bpp = channels * bit_depth // 8
+    raw = b""
+    for y in range(height):
+        row = bytearray()
+        for x in range(width):
+            v = (x * 16 + y * 3) % 256
+            row += bytes([v] * bpp)
+        raw += b"\x00" + bytes(row)
+    ihdr = struct.pack(">IIBBBBB", width, height, bit_depth, color_type, 0, 0, 0)
+    body = chunk(b"IHDR", ihdr)
+    if palette is not None:
+        body += chunk(b"PLTE", palette)
+    return b"\x89PNG\r\n\x1a\n" + body + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b"")
+
+
+seed("image", "gray8_16x16.png", png(16, 16, 8, 0, 1))
+seed("image", "gray16_20x16.png", png(20, 16, 16, 0, 1))
+seed("image", "rgb8_16x18.png", png(16, 18, 8, 2, 3))
+seed("image", "rgba8_16x16.png", png(16, 16, 8, 6, 4))
+seed("image", "palette_16x16.png", png(16, 16, 8, 3, 1, bytes(range(256)) * 3))
+seed("image", "pgm_16x16.pgm", b"P5\n16 16\n255\n" + bytes((x * 16) % 256 for x in range(256)))
+
+seed("timestamps", "iso.txt", "".join("1970-01-01T00:16:40.%09d\n" % (33333333 * k) for k in range(3)))
+seed("timestamps", "seconds.txt", "1403715529.112143517\n1403715529.145476850\n1403715529.178810183\n")
+seed("timestamps", "edges.txt", "-4611686018.427387903\n0\n4611686018.427387903\n")
+
+# Ouster: a tiny sensor (4 beams, 32 columns, 2 packets a frame) as metadata JSON, `--pcap--`, pcap.
+import json
+
+
+def ouster_meta(profile):
+    return json.dumps({
+        "prod_line": "OS-1-16", "prod_sn": "122", "initialization_id": 5, "lidar_mode": "32x10",
+        "image_rev": "ousteros-image-prod-aries-v2.3.0", "udp_port_lidar": 7502, "udp_port_imu": 7503,
+        "beam_altitude_angles": [15.0, 5.0, -5.0, -15.0], "beam_azimuth_angles": [3.0, 1.0, -1.0, -3.0],
+        "lidar_origin_to_beam_origin_mm": 15.806,
+        "data_format": {"pixels_per_column": 4, "columns_per_frame": 32, "columns_per_packet": 16,
+                        "column_window": [0, 31], "pixel_shift_by_row": [3, 1, -1, -3],
+                        "udp_profile_lidar": profile, "udp_profile_imu": "LEGACY"}})
+
+
+def ouster_lidar_packet(profile, frame_id, first_column):
+    cols = b""
+    for c in range(16):
+        ts = 1_000_000_000 + frame_id * 100_000_000 + (first_column + c) * 3_125_000
+        if profile == "LEGACY":
+            blocks = b"".join(struct.pack("<IHHHH", 5000 + 100 * u, 30, 200, 50, 0) for u in range(4))
+            cols += struct.pack("<QHHI", ts, first_column + c, frame_id, 0) + blocks + b"\xff\xff\xff\xff"
+        else:  # RNG15_RFL8_NIR8: range in 8 mm units, flags, reflectivity, near-IR / 16
+            blocks = b"".join(struct.pack("<I", (625 + 10 * u) | (40 << 16) | (3 << 24)) for u in range(4))
+            cols += struct.pack("<QHH", ts, first_column + c, 1) + blocks
+    if profile == "LEGACY":
+        return cols
+    header = struct.pack("<HHI", 1, frame_id, 5 | ((122 & 0xFF) << 24)) + struct.pack("<I", 122 >> 8)
+    return header + bytes(32 - len(header)) + cols + bytes(32)
+
+
+def ouster_imu_packet(t):
+    return struct.pack("<QQQffffff", t, t, t, 0.01, -0.02, 1.0, 0.5, -0.3, 0.1)
+
+
+def pcap(datagrams):
+    out = struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 1)
+    for k, (port, payload, fragments) in enumerate(datagrams):
+        udp = struct.pack(">HHHH", 7502, port, 8 + len(payload), 0) + payload
+        pieces = [udp] if fragments == 1 else [udp[:(len(udp) // 2) & ~7], udp[(len(udp) // 2) & ~7:]]
+        at = 0
+        for i, piece in enumerate(pieces):
+            more = 0x2000 if i + 1 < len(pieces) else 0
+            ip = struct.pack(">BBHHHBBH4s4s", 0x45, 0, 20 + len(piece), 100 + k, more | (at // 8), 64, 17,
+                             0, bytes([10, 5, 5, 87]), bytes([10, 5, 5, 1]))
+            frame = bytes(6) + bytes([0, 1, 2, 3, 4, 5]) + b"\x08\x00" + ip + piece
+            out += struct.pack("<IIII", 1000, 1000 * (k + 1), len(frame), len(frame)) + frame
+            at += len(piece)
+    return out
+
+
+for profile in ("RNG15_RFL8_NIR8", "LEGACY"):
+    grams = []
+    for frame_id in (7, 8):
+        for first in (0, 16):
+            grams.append((7502, ouster_lidar_packet(profile, frame_id, first), 2 if first == 16 else 1))
+        grams.append((7503, ouster_imu_packet(1_000_000_000 + frame_id * 100_000_000), 1))
+    grams.append((7502, ouster_lidar_packet(profile, 6, 0), 1))  # stale: before the last frame
+    seed("ouster", "tiny_%s.txt" % profile.lower(),
+         ouster_meta(profile).encode() + b"\n--pcap--\n" + pcap(grams))

@@ -60,6 +60,18 @@ case $target in
     for t in "$f"/lidar/kitti00_pcd/*.pcd; do bytes 65536 "$t"; break; done
     for t in "$f"/lidar_camera/acfr/*/pcd/*.pcd; do bytes 65536 "$t"; break; done ;;
   point_cloud_bin) for t in "$f"/lidar/kitti00_bin/*.bin; do bytes 65536 "$t"; break; done ;;
+  image) # whole JPEGs under the length limit (a cut one would only test truncation)
+    for t in "$f"/stereo/opencv_samples/left0{1,3}.jpg; do
+      [[ -f $t && $(stat -c %s "$t") -le 65536 ]] && cp "$t" "$seeds"/ || true
+    done ;;
+  ouster) # a metadata JSON, the separator, the capture's first bytes (a few packets)
+    for t in ouster_sdk/OS-1-32-G_v2.1.1_1024x10 ouster_sdk/crc_test ouster_sdk/duplicate_id \
+             ouster_sdk/OS-0-32-U1_v2.2.0_1024x10; do
+      if [[ -f $f/lidar/$t.json && -f $f/lidar/$t.pcap ]]; then
+        { cat "$f/lidar/$t.json"; printf '\n--pcap--\n'; head -c 40000 "$f/lidar/$t.pcap"; } \
+          > "$seeds/$(basename "$t").head"
+      fi
+    done ;;
 esac
 if [[ $have_fixtures == 1 ]]; then
   echo "seeds of $target: $(ls "$seeds" | wc -l) (fixtures from $fixtures included)"

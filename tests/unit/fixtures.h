@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 
 #include "rigcal/core/error.h"
 
@@ -20,6 +21,18 @@ inline std::filesystem::path fixtures_dir() {
 inline std::string fixture(const std::string& relative) {
   const std::filesystem::path p = fixtures_dir() / relative;
   return std::filesystem::exists(p) ? p.string() : std::string();
+}
+
+// The message of the rigcal::Error `f` throws ("" and a failure when it throws nothing).
+template <typename F>
+std::string error_message_of(F&& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no rigcal::Error";
+  return "";
 }
 
 // A test with its own scratch folder (removed after the test), files written into it, and the
@@ -42,13 +55,7 @@ class ScratchTest : public ::testing::Test {
   // The message of the rigcal::Error `f` throws ("" and a failure when it throws nothing).
   template <typename F>
   static std::string error_of(F&& f) {
-    try {
-      f();
-    } catch (const Error& e) {
-      return e.what();
-    }
-    ADD_FAILURE() << "no rigcal::Error";
-    return "";
+    return error_message_of(std::forward<F>(f));
   }
   std::filesystem::path dir_;
 };

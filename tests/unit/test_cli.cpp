@@ -658,7 +658,9 @@ TEST_F(Cli, NumericOptionsAreCheckedAndABomIsReadPast) {
     r = run("hand-eye --lidar " + tum.string() + " --gnss " + tum.string() + " " +
             std::string(opt));
     EXPECT_EQ(r.status, 2) << opt << ": " << r.err;
-    EXPECT_NE(r.err.find("expected a finite number"), std::string::npos) << opt << ": " << r.err;
+    EXPECT_TRUE(r.err.find("expected a finite number") != std::string::npos ||
+                r.err.find("expected seconds from") != std::string::npos)
+        << opt << ": " << r.err;
   }
   r = run("bench --gt-dir " + dir_.string() + " --est-dir " + dir_.string() +
           " --methods a --ate-max nan");
@@ -1097,7 +1099,7 @@ TEST_F(Cli, HandEyeWritesTheExtrinsicAndRefusesAnUndeterminedDirection) {
   EXPECT_NE(r.err.find("expected x=METRES,SIGMA"), std::string::npos) << r.err;
   r = run("hand-eye" + args(car) + " --spacing 0.3,0");
   EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.err.find("must be positive"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--spacing: expected seconds from 0.001"), std::string::npos) << r.err;
   // Trajectories that do not overlap in time, and too few pairs: exit 2.
   const fs::path a = write("a.tum", "0 0 0 0 0 0 0 1\n1 1 0 0 0 0 0 1\n2 2 0 0 0 0 0 1\n");
   const fs::path b = write("b.tum", "100 0 0 0 0 0 0 1\n101 1 0 0 0 0 0 1\n102 2 0 0 0 0 0 1\n");
@@ -1107,4 +1109,57 @@ TEST_F(Cli, HandEyeWritesTheExtrinsicAndRefusesAnUndeterminedDirection) {
   r = run("hand-eye --lidar " + a.string() + " --gnss " + a.string());
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("too few or too small motions"), std::string::npos) << r.err;
+}
+
+// What the full bad-input sweep (tests/sweep) found after the first round of fixes: each
+// answered with exit 2 and a message naming the file or option, no input touched.
+TEST_F(Cli, SweepFindingsAreBadInputNotInternalErrors) {
+  const fs::path cfg = write("tiny.yaml", "seed: 3\nimu_duration_s: 4\n");
+  // --force on the folder holding the inputs (here the working folder) would remove them.
+  const std::string in_dir = "cd " + dir_.string() + " && ";
+  const int raw = std::system((in_dir + RIGCAL_CLI +
+                               " simulate --out . --force --what imu "
+                               "--config tiny.yaml > out.txt 2> err.txt")
+                                  .c_str());
+  EXPECT_EQ(WEXITSTATUS(raw), 2);
+  EXPECT_NE(slurp(dir_ / "err.txt").find("holds the current folder"), std::string::npos)
+      << slurp(dir_ / "err.txt");
+  EXPECT_TRUE(fs::exists(cfg));
+  CliRun r =
+      run("simulate --out " + dir_.string() + " --force --what imu --config " + cfg.string());
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("holds"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::exists(cfg));
+
+  // A simulated IMU session: time-offset may not write into the folder it reads.
+  const fs::path session = dir_ / "imus";
+  ASSERT_EQ(
+      run("simulate --what imu --out " + session.string() + " --config " + cfg.string()).status, 0);
+  const fs::path imu_txt = session / "imu" / "data" / "imu.txt";
+  const std::string before = slurp(imu_txt);
+  r = run("time-offset --session " + session.string() + " --rig " + kSample +
+          " --sensor imu --out " + imu_txt.string());
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("is an input"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(imu_txt), before);
+  r = run("time-offset --session " + session.string() + " --window 1e-320");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--window"), std::string::npos) << r.err;
+
+  // Spans of seconds checked as options (they used to fail later, naming no option).
+  for (const std::string opt : {"--spacing inf", "--spacing 1e-320", "--stride 1e308"}) {
+    r = run("hand-eye --lidar a.tum --gnss b.tum " + opt);
+    EXPECT_EQ(r.status, 2) << opt;
+    EXPECT_NE(r.err.find(opt.substr(0, opt.find(' '))), std::string::npos) << r.err;
+  }
+  r = run("bench --gt a.txt --est b.txt --max-diff 1e308");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--max-diff"), std::string::npos) << r.err;
+
+  // A link loop as an input: the file system's refusal is bad input (exit 2), naming the path.
+  fs::create_symlink(dir_ / "loop_a", dir_ / "loop_b");
+  fs::create_symlink(dir_ / "loop_b", dir_ / "loop_a");
+  r = run("bench --gt " + (dir_ / "loop_a").string() + " --est " + (dir_ / "loop_a").string());
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("loop_a"), std::string::npos) << r.err;
 }

@@ -19,10 +19,15 @@
 #include "rigcal/core/error.h"
 #include "rigcal/core/text.h"
 #include "rigcal/io/files.h"
+#include "rigcal/io/gnss_fixes.h"
 #include "rigcal/io/image_io.h"
+#include "rigcal/io/image_sets.h"
 #include "rigcal/io/point_cloud_io.h"
+#include "rigcal/io/sim_config.h"
 #include "rigcal/io/target_yaml.h"
+#include "rigcal/io/trajectory_io.h"
 #include "rigcal/io/yaml.h"
+#include "rigcal/report/json.h"
 #include "rigcal/rig/rig_yaml.h"
 
 namespace rigcal::io {
@@ -190,9 +195,10 @@ TEST_F(InputLimits, YamlSizeAndAliasExpansionAreBounded) {
               "li\xFF"
               "ar");
   const std::string name_error = error_of([&] { rig::parse_rig_yaml(bad, "r.yaml"); });
-  EXPECT_NE(name_error.find("key 'li\\xFFar': a sensor name must be printable text"),
-            std::string::npos)
+  // Refused as text that is not UTF-8, on the sensor's line, before any key is read.
+  EXPECT_NE(name_error.find("r.yaml:30: bytes that are not UTF-8"), std::string::npos)
       << name_error;
+  EXPECT_EQ(name_error, printable(name_error, 1000));  // the message itself stays printable
 }
 
 TEST_F(InputLimits, TargetsOutsideWhatPeoplePrintAreRefused) {
@@ -247,6 +253,126 @@ TEST_F(InputLimits, OneRunPerOutputFolder) {
   }
   EXPECT_NO_THROW(FolderLock again(out));
   EXPECT_EQ(std::distance(fs::directory_iterator(out), fs::directory_iterator{}), 0);
+}
+
+TEST_F(InputLimits, MetadataJsonLargerThanAnyMessageTypeIsRefusedUnparsed) {
+  const fs::path bin = write("ouster_points/data/0000000000.bin", std::string(16 * 1024, '\0'));
+  // Valid JSON whose size alone is past the limit: a parser would take it.
+  write("ouster_points/.metadata.json",
+        "{\"fields\": [], \"pad\": \"" + std::string(kMaxMetadataBytes, 'x') + "\"}");
+  const std::string e = error_of([&] { read_point_cloud(bin); });
+  EXPECT_NE(e.find(".metadata.json: "), std::string::npos) << e;
+  EXPECT_NE(e.find("over the limit of 1048576 bytes"), std::string::npos) << e;
+}
+
+TEST_F(InputLimits, TopicStampsOutOfOrderOrRepeatedAreRefusedWithTheLine) {
+  for (const char* f : {"a.png", "b.png", "c.png"}) write(fs::path("cam/data") / f, "");
+  write("cam/timestamps.txt", "1.0\n2.0\n3.0\n");
+  EXPECT_EQ(read_stamped_folder(dir_ / "cam", ".png").stamps.size(), 3u);
+  write("cam/timestamps.txt", "1.0\n2.0\n2.0\n");
+  std::string e = error_of([&] { read_stamped_folder(dir_ / "cam", ".png"); });
+  EXPECT_NE(e.find("timestamps.txt:3: stamp 2.000000000 is not after the previous line's"),
+            std::string::npos)
+      << e;
+  write("cam/timestamps.txt", "1970-01-01T00:00:02\n1970-01-01T00:00:01\n3\n");
+  e = error_of([&] { read_stamped_folder(dir_ / "cam", ".png"); });
+  EXPECT_NE(e.find("timestamps.txt:2: "), std::string::npos) << e;
+  // A stamp past the range read (its difference with another would overflow) names the range.
+  write("cam/timestamps.txt", "-4611686018\n0\n9223372036.8\n");
+  e = error_of([&] { read_stamped_folder(dir_ / "cam", ".png"); });
+  EXPECT_NE(e.find("timestamps.txt:3: "), std::string::npos) << e;
+  EXPECT_NE(e.find("146 years"), std::string::npos) << e;
+  // A garbage byte in a stamp is quoted escaped.
+  write("cam/timestamps.txt", "1\n2\xFF\n3\n");
+  e = error_of([&] { read_stamped_folder(dir_ / "cam", ".png"); });
+  EXPECT_NE(e.find("'2\\xFF'"), std::string::npos) << e;
+}
+
+TEST_F(InputLimits, YamlIsOneDocumentOfStandardTagsWithoutNulOrRepeatedKeys) {
+  EXPECT_NE(error_of([] {
+              load_yaml("a: 1\n---\nb: 2\n", "x.yaml");
+            }).find("x.yaml:3: a second YAML document"),
+            std::string::npos);
+  EXPECT_NO_THROW(load_yaml("a: 1\n---\n", "x.yaml"));  // an empty second document
+  EXPECT_NE(error_of([] {
+              load_yaml("---\na: 1\n...\n---\n# c\n...\nb: 2\n", "x.yaml");
+            }).find("x.yaml:7: a second YAML document"),
+            std::string::npos);
+  // A lone ',' makes yaml-cpp 0.7's parser return empty documents without end (YAML::LoadAll
+  // then fills memory): read as one empty document, in bounded time.
+  for (const char* comma : {",", "\n,\n", "a: 1\n---\n,\n"})
+    EXPECT_NO_THROW(load_yaml(comma, "x.yaml")) << comma;
+  EXPECT_NE(error_of([] {
+              load_yaml("a: 1\nb: !!binary aGVsbG8=\n", "x.yaml");
+            }).find("x.yaml:2: YAML tag 'tag:yaml.org,2002:binary'"),
+            std::string::npos);
+  EXPECT_NO_THROW(load_yaml("a: !!str 1\nb: !!float 2\n", "x.yaml"));
+  EXPECT_NO_THROW(load_yaml("name: caf\xC3\xA9 \xE2\x82\xAC \xF0\x9F\x98\x80\n", "x.yaml"));
+  for (const char* bad : {"a: 1\nname: x\xFF\n", "a: 1\nname: \xC0\xAF\n",
+                          "a: 1\nname: \xED\xA0\x80\n", "a: 1\nname: \xE2\x82\n"}) {
+    EXPECT_NE(
+        error_of([&] { load_yaml(bad, "x.yaml"); }).find("x.yaml:2: bytes that are not UTF-8"),
+        std::string::npos)
+        << bad;
+  }
+  EXPECT_NE(error_of([] {
+              load_yaml(std::string("a: 1\n# x\0y\n", 11), "x.yaml");
+            }).find("x.yaml:2: a NUL byte"),
+            std::string::npos);
+  // Repeated keys in a target and a simulator config (the calibration YAML has its own words).
+  const std::string target =
+      "target_type: checkerboard\ntargetCols: 8\ntargetRows: 5\nrowSpacingMeters: 0.04\n"
+      "colSpacingMeters: 0.04\n";
+  EXPECT_NO_THROW(parse_target_yaml(target, "t.yaml"));
+  EXPECT_NE(error_of([&] {
+              parse_target_yaml(target + "targetCols: 9\n", "t.yaml");
+            }).find("t.yaml:6: key 'targetCols': given twice"),
+            std::string::npos);
+  sim::SimConfig config;
+  EXPECT_NE(error_of([&] {
+              apply_sim_config("seed: 1\nimu: {rate_hz: 100, rate_hz: 200}\n", "s.yaml", config);
+            }).find("s.yaml:2: key 'rate_hz': given twice"),
+            std::string::npos);
+}
+
+TEST_F(InputLimits, PositionsAndHeightsBeyondAnyRigAreRefused) {
+  const std::string e =
+      error_of([] { parse_trajectory("0 0 0 0 0 0 0 1\n1 1e308 0 0 0 0 0 1\n", "t.tum", {}); });
+  EXPECT_NE(e.find("t.tum:2: position (1e+308, 0, 0) m lies beyond 1e+09 m"), std::string::npos)
+      << e;
+  const std::string f = error_of([] {
+    parse_gnss_fixes("time,lat,lon,height,roll,pitch,yaw\n0,41.9,12.5,-1e7,0,0,0\n", "f.csv",
+                     Attitude::enu);
+  });
+  EXPECT_NE(f.find("f.csv:2: height -10000000 m outside -12 km to 100 km"), std::string::npos) << f;
+}
+
+TEST_F(InputLimits, ReplacingAFolderNeverRemovesAnInput) {
+  const fs::path in = write("out/config.yaml", "seed: 1\n");
+  EXPECT_NE(error_of([&] {
+              refuse_replacing_inputs(dir_ / "out", {{"--config", in}});
+            }).find("holds an input (--config"),
+            std::string::npos);
+  EXPECT_NO_THROW(refuse_replacing_inputs(dir_ / "other", {{"--config", in}}));
+  EXPECT_NE(error_of([] {
+              refuse_replacing_inputs(fs::current_path().parent_path(), {});
+            }).find("holds the current folder"),
+            std::string::npos);
+  // An input behind a link loop cannot be resolved: compared as written, never "equal" to an
+  // unrelated output (the check said ": is an input" of an empty output before).
+  fs::create_symlink(dir_ / "b", dir_ / "a");
+  fs::create_symlink(dir_ / "a", dir_ / "b");
+  EXPECT_NO_THROW(
+      refuse_outputs_over_inputs({{dir_ / "x.yaml", ""}, {"", ""}}, {{"--lidar", dir_ / "a"}}));
+  EXPECT_THROW(refuse_outputs_over_inputs({{dir_ / "a", ""}}, {{"--lidar", dir_ / "a"}}), Error);
+}
+
+TEST(ReportJson, InvalidUtf8InNamesIsReplacedNotThrown) {
+  nlohmann::json j;
+  j["method"] = "m1\xFF";  // a name quoted from a damaged file
+  const std::string text = report::json_text(j);
+  EXPECT_NE(text.find("m1\xEF\xBF\xBD"), std::string::npos) << text;  // U+FFFD
+  EXPECT_EQ(text.back(), '\n');
 }
 
 TEST(Printable, InvalidBytesAndLineBreaksAreEscapedAndLongTextCut) {

@@ -18,7 +18,9 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "cli_run.h"
 #include "devkit_layout.h"
+#include "fixtures.h"
 #include "rigcal/core/error.h"
 #include "rigcal/core/sha256.h"
 #include "rigcal/io/files.h"
@@ -33,31 +35,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-struct CliRun {
-  int status = -1;
-  std::string out, err;
-  double seconds = 0;
-};
-
-CliRun rigcal_cli(const std::string& args, const fs::path& scratch) {
-  const fs::path out = scratch / "stdout.txt", err = scratch / "stderr.txt";
-  const auto t0 = std::chrono::steady_clock::now();
-  const int raw = std::system(
-      fmt::format("{} {} > {} 2> {}", RIGCAL_CLI, args, out.string(), err.string()).c_str());
-  CliRun r;
-  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
-}
+using testing::CliRun;
+using testing::rigcal_cli;
+using testing::slurp;
 
 // The IMU CSV under the devkit's header: rigcal's simulator writes the same columns (acc, gyro,
 // quaternion wxyz, three covariances) under the ROS field names.
@@ -204,7 +184,17 @@ TEST_F(Session, SessionYamlErrorsNameKeyAndLine) {
       EXPECT_NE(std::string(e.what()).find("session.yaml:"), std::string::npos) << e.what();
     }
   }
+  // A name the file system refuses (longer than 255 bytes) is the key's error, with its line.
+  std::ofstream(root / "session.yaml") << "cameras: stereo\nrig: " << std::string(300, 'r') << "\n";
+  const std::string too_long = testing::error_message_of([&] { io::read_session(root); });
+  EXPECT_NE(too_long.find("session.yaml:2"), std::string::npos) << too_long;
+  EXPECT_NE(too_long.find("too long"), std::string::npos) << too_long;
   EXPECT_THROW(io::read_session(root / "absent"), Error);
+  // A file that is neither a bag nor a capture is said to be neither.
+  std::ofstream(root / "notes.txt") << "not a recording\n";
+  const std::string text_file =
+      testing::error_message_of([&] { io::read_session(root / "notes.txt"); });
+  EXPECT_NE(text_file.find("nor a ROS1 bag"), std::string::npos) << text_file;
 }
 
 // Acceptance: one run on the devkit-layout session with the board missing from every
