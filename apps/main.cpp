@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <opencv2/core/utils/logger.hpp>
 
 #include "cli.h"
 #include "rigcal/core/error.h"
@@ -18,6 +19,9 @@ std::string one_line(const char* message) { return rigcal::printable(message, 20
 }  // namespace
 
 int main(int argc, char** argv) {
+  // OpenCV's warnings (a decoder's "can't read data" before rigcal's own error on the same file)
+  // are not rigcal's one line: only its errors are kept.
+  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
   CLI::App app{
       "rigcal: calibrates a multi-sensor rig (stereo cameras, LiDAR, IMUs, GNSS/INS), publishes\n"
       "the calibration as YAML, and scores trajectories. Conventions: T_a_b maps points of frame\n"

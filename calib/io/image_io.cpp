@@ -22,7 +22,7 @@
 namespace rigcal::io {
 namespace {
 
-enum class ImageFormat { unknown, png, jpeg, pnm, bmp };
+enum class ImageFormat { unknown, png, jpeg, pnm, bmp, tiff };
 struct ImageHeader {
   ImageFormat format = ImageFormat::unknown;
   long long width = 0, height = 0;
@@ -33,9 +33,55 @@ uint32_t big_endian32(const unsigned char* p) {
   return uint32_t(p[0]) << 24 | uint32_t(p[1]) << 16 | uint32_t(p[2]) << 8 | p[3];
 }
 
+// A classic TIFF's width and height (tags 256 and 257, SHORT or LONG) from its first directory;
+// unsized when the directory is not within the bytes or lacks either tag. What a decoder would
+// allocate beyond the image is refused here too: samples wider than 16 bit or more than 4 a pixel
+// (the reader keeps 8 and 16 bit), and tiles (cameras write strips; a tile's size is its own).
+ImageHeader probe_tiff(const unsigned char* b, size_t n, const std::string& name) {
+  ImageHeader h;
+  h.format = ImageFormat::tiff;
+  const bool little = b[0] == 'I';
+  auto u16 = [&](size_t i) { return little ? b[i] | b[i + 1] << 8 : b[i] << 8 | b[i + 1]; };
+  auto u32 = [&](size_t i) {
+    return little ? uint32_t(u16(i)) | uint32_t(u16(i + 2)) << 16
+                  : uint32_t(u16(i)) << 16 | uint32_t(u16(i + 2));
+  };
+  const size_t ifd = u32(4);
+  if (ifd < 8 || ifd > n || n - ifd < 2) return h;
+  const size_t count = u16(ifd);
+  bool width = false, height = false;
+  for (size_t k = 0; k < count && ifd + 2 + 12 * (k + 1) <= n; ++k) {
+    const size_t e = ifd + 2 + 12 * k;
+    const int tag = u16(e), type = u16(e + 2);
+    const uint32_t values = u32(e + 4);
+    if (tag == 322 || tag == 323 || tag == 324 || tag == 325) {
+      throw Error(
+          fmt::format("{}: a tiled TIFF (rigcal reads TIFFs of strips, as cameras write)", name));
+    }
+    if (type != 3 && type != 4) continue;
+    // The first value: inline when the values fit 4 bytes, else at the offset given.
+    size_t at = e + 8;
+    if (values * (type == 3 ? 2ull : 4ull) > 4) {
+      at = u32(e + 8);
+      if (at > n || n - at < 4) continue;
+    }
+    const long long v = type == 3 ? u16(at) : u32(at);
+    if (tag == 256) h.width = v, width = values == 1;
+    if (tag == 257) h.height = v, height = values == 1;
+    if (tag == 258 && v > 16) {
+      throw Error(fmt::format("{}: a TIFF of {}-bit samples (rigcal reads 8 or 16 bit)", name, v));
+    }
+    if (tag == 277 && v > 4) {
+      throw Error(fmt::format("{}: a TIFF of {} samples a pixel (at most 4)", name, v));
+    }
+  }
+  h.sized = width && height;
+  return h;
+}
+
 // The format and size an image file declares, read from its first bytes only, so a header that
 // claims 100000 x 100000 px is refused before anything is allocated.
-ImageHeader probe_image(std::string_view bytes) {
+ImageHeader probe_image(std::string_view bytes, const std::string& name) {
   const auto* b = reinterpret_cast<const unsigned char*>(bytes.data());
   const size_t n = bytes.size();
   ImageHeader h;
@@ -86,6 +132,10 @@ ImageHeader probe_image(std::string_view bytes) {
     }
     h.width = v[0], h.height = v[1], h.sized = true;
     return h;
+  }
+  if (n >= 8 && (bytes.substr(0, 4) == std::string_view("II*\0", 4) ||
+                 bytes.substr(0, 4) == std::string_view("MM\0*", 4))) {
+    return probe_tiff(b, n, name);
   }
   if (n >= 26 && b[0] == 'B' && b[1] == 'M') {
     int32_t w, ht;
@@ -209,7 +259,15 @@ std::string_view to_string(Bayer bayer) {
 cv::Mat read_gray(const std::filesystem::path& path, Bayer bayer) {
   const std::string name = path.string();
   const std::string bytes = read_text_file(path);  // binary-safe
-  const ImageHeader header = probe_image(bytes);
+  const ImageHeader header = probe_image(bytes, name);
+  // Only the formats probed above reach a decoder: OpenCV's other decoders (WebP, EXR, JPEG 2000,
+  // HDR, Sun raster, PAM, PFM, GDAL's) are neither needed by a camera rig nor size-checked here.
+  if (header.format == ImageFormat::unknown) {
+    throw Error(fmt::format("{}: not an image rigcal reads (PNG, JPEG, TIFF, PNM or BMP)", name));
+  }
+  if (header.format == ImageFormat::tiff && !header.sized) {
+    throw Error(fmt::format("{}: TIFF without its width and height in the first directory", name));
+  }
   if (header.sized) check_image_size(header, name);
   cv::Mat img;
   if (header.format == ImageFormat::jpeg) {

@@ -8,6 +8,7 @@
 #include <zlib.h>
 
 #include <chrono>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -128,6 +129,70 @@ TEST_F(InputLimits, JpegDecodesExactlyAsOpenCvAndDamageIsAnError) {
   const std::string what = error_of([&] { read_gray(cut); });
   EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
   EXPECT_EQ(what.rfind(cut.string() + ": the JPEG is damaged (", 0), 0u) << what;
+}
+
+TEST_F(InputLimits, OnlyTheFormatsOfACameraRigReachADecoder) {
+  // PNG, TIFF, PNM and BMP (8 and 16 bit) give OpenCV's pixels.
+  const cv::Mat gray8 = pattern(20, 24, CV_8UC1), color = pattern(20, 24, CV_8UC3);
+  cv::Mat gray16(20, 24, CV_16UC1);
+  cv::randu(gray16, 0, 65535);
+  for (const std::string ext : {".png", ".tif", ".pgm", ".bmp"}) {
+    for (const cv::Mat* image : {&gray8, &color, &gray16}) {
+      if (image->depth() == CV_16U && (ext == ".bmp" || ext == ".pgm")) continue;
+      const fs::path f = write("i" + ext, encoded(ext, *image));
+      cv::Mat expected = cv::imread(f.string(), cv::IMREAD_UNCHANGED);
+      if (expected.depth() == CV_16U) expected.convertTo(expected, CV_8U, 1.0 / 256);
+      if (expected.channels() == 3) cv::cvtColor(expected, expected, cv::COLOR_BGR2GRAY);
+      const cv::Mat mine = read_gray(f);
+      ASSERT_EQ(mine.size(), expected.size()) << ext;
+      EXPECT_EQ(cv::norm(mine, expected, cv::NORM_INF), 0) << ext;
+    }
+  }
+  // A TIFF's size is read from its first directory before decoding: width 40000 is refused.
+  std::string tiff = encoded(".tif", gray8);
+  ASSERT_EQ(tiff.substr(0, 4), std::string("II*\0", 4));
+  uint32_t ifd;
+  std::memcpy(&ifd, tiff.data() + 4, 4);
+  uint16_t entries;
+  std::memcpy(&entries, tiff.data() + ifd, 2);
+  bool patched = false;
+  for (uint16_t k = 0; k < entries; ++k) {
+    char* e = tiff.data() + ifd + 2 + 12 * k;
+    uint16_t tag, type;
+    std::memcpy(&tag, e, 2);
+    std::memcpy(&type, e + 2, 2);
+    if (tag != 256) continue;
+    const uint32_t width = 40000;
+    if (type == 3) std::memcpy(e + 8, &width, 2);  // 40000 fits a SHORT
+    if (type == 4) std::memcpy(e + 8, &width, 4);
+    patched = true;
+  }
+  ASSERT_TRUE(patched);
+  const fs::path wide = write("wide.tif", tiff);
+  EXPECT_EQ(error_of([&] { read_gray(wide); }),
+            wide.string() +
+                ": 40000 x 20 px is larger than rigcal reads (at most 32768 px a side "
+                "and 100 Mpx)");
+  const fs::path bare = write("bare.tif", tiff.substr(0, 8));
+  EXPECT_EQ(error_of([&] { read_gray(bare); }),
+            bare.string() + ": TIFF without its width and height in the first directory");
+  // Samples wider than the reader keeps are refused from the header.
+  const fs::path floats = write("f.tif", encoded(".tif", cv::Mat(20, 24, CV_32FC1, 0.5)));
+  EXPECT_EQ(error_of([&] { read_gray(floats); }),
+            floats.string() + ": a TIFF of 32-bit samples (rigcal reads 8 or 16 bit)");
+  // Formats OpenCV decodes but rigcal does not read are refused before any decoder sees them.
+  for (const std::string ext : {".webp", ".jp2", ".hdr", ".ras", ".pfm", ".pam"}) {
+    std::vector<uchar> buffer;
+    try {
+      if (!cv::imencode(ext, ext == ".hdr" || ext == ".pfm" ? cv::Mat(color) : gray8, buffer))
+        continue;
+    } catch (const cv::Exception&) {
+      continue;  // no encoder in this OpenCV: nothing to refuse
+    }
+    const fs::path f = write("i" + ext, std::string(buffer.begin(), buffer.end()));
+    EXPECT_EQ(error_of([&] { read_gray(f); }),
+              f.string() + ": not an image rigcal reads (PNG, JPEG, TIFF, PNM or BMP)");
+  }
 }
 
 TEST_F(InputLimits, PcdPointCountsAreCheckedAgainstTheData) {
