@@ -134,8 +134,9 @@ TEST_F(InputLimits, JpegDecodesExactlyAsOpenCvAndDamageIsAnError) {
 TEST_F(InputLimits, OnlyTheFormatsOfACameraRigReachADecoder) {
   // PNG, TIFF, PNM and BMP (8 and 16 bit) give OpenCV's pixels.
   const cv::Mat gray8 = pattern(20, 24, CV_8UC1), color = pattern(20, 24, CV_8UC3);
-  cv::Mat gray16(20, 24, CV_16UC1);
-  cv::randu(gray16, 0, 65535);
+  cv::Mat random16(20, 24, CV_16UC1);
+  cv::randu(random16, 0, 65535);
+  const cv::Mat gray16 = random16;
   for (const std::string ext : {".png", ".tif", ".pgm", ".bmp"}) {
     for (const cv::Mat* image : {&gray8, &color, &gray16}) {
       if (image->depth() == CV_16U && (ext == ".bmp" || ext == ".pgm")) continue;
