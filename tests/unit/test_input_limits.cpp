@@ -140,6 +140,7 @@ TEST_F(InputLimits, OnlyTheFormatsOfACameraRigReachADecoder) {
   for (const std::string ext : {".png", ".tif", ".pgm", ".bmp"}) {
     for (const cv::Mat* image : {&gray8, &color, &gray16}) {
       if (image->depth() == CV_16U && (ext == ".bmp" || ext == ".pgm")) continue;
+      if (image->channels() == 3 && ext == ".pgm") continue;  // PGM is gray only
       const fs::path f = write("i" + ext, encoded(ext, *image));
       cv::Mat expected = cv::imread(f.string(), cv::IMREAD_UNCHANGED);
       if (expected.depth() == CV_16U) expected.convertTo(expected, CV_8U, 1.0 / 256);
