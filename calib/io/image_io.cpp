@@ -34,7 +34,7 @@ uint32_t big_endian32(const unsigned char* p) {
 }
 
 // A classic TIFF's width and height (tags 256 and 257, SHORT or LONG) from its first directory;
-// unsized when the directory is not within the bytes or lacks either tag. What a decoder would
+// refused when the directory is not within the bytes or lacks either tag. What a decoder would
 // allocate beyond the image is refused here too: samples wider than 16 bit or more than 4 a pixel
 // (the reader keeps 8 and 16 bit), and tiles (cameras write strips; a tile's size is its own).
 ImageHeader probe_tiff(const unsigned char* b, size_t n, const std::string& name) {
@@ -47,8 +47,7 @@ ImageHeader probe_tiff(const unsigned char* b, size_t n, const std::string& name
                   : uint32_t(u16(i)) << 16 | uint32_t(u16(i + 2));
   };
   const size_t ifd = u32(4);
-  if (ifd < 8 || ifd > n || n - ifd < 2) return h;
-  const size_t count = u16(ifd);
+  const size_t count = ifd < 8 || ifd > n || n - ifd < 2 ? 0 : u16(ifd);
   bool width = false, height = false;
   for (size_t k = 0; k < count && ifd + 2 + 12 * (k + 1) <= n; ++k) {
     const size_t e = ifd + 2 + 12 * k;
@@ -75,7 +74,10 @@ ImageHeader probe_tiff(const unsigned char* b, size_t n, const std::string& name
       throw Error(fmt::format("{}: a TIFF of {} samples a pixel (at most 4)", name, v));
     }
   }
-  h.sized = width && height;
+  if (!width || !height) {
+    throw Error(fmt::format("{}: TIFF without its width and height in the first directory", name));
+  }
+  h.sized = true;
   return h;
 }
 
@@ -264,9 +266,6 @@ cv::Mat read_gray(const std::filesystem::path& path, Bayer bayer) {
   // HDR, Sun raster, PAM, PFM, GDAL's) are neither needed by a camera rig nor size-checked here.
   if (header.format == ImageFormat::unknown) {
     throw Error(fmt::format("{}: not an image rigcal reads (PNG, JPEG, TIFF, PNM or BMP)", name));
-  }
-  if (header.format == ImageFormat::tiff && !header.sized) {
-    throw Error(fmt::format("{}: TIFF without its width and height in the first directory", name));
   }
   if (header.sized) check_image_size(header, name);
   cv::Mat img;
