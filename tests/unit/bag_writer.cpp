@@ -10,6 +10,7 @@
 #include <std_msgs/String.h>
 
 #include <algorithm>
+#include <climits>
 #include <cstring>
 #include <tuple>
 
@@ -96,6 +97,19 @@ sensor_msgs::NavSatFix fix(int k) {
   return m;
 }
 
+sensor_msgs::Imu gyro_message(const ImuTopic& t, size_t k) {
+  sensor_msgs::Imu m;
+  m.header.stamp = ros_time(t.stamps_ns[k]);
+  m.header.seq = static_cast<uint32_t>(k);
+  m.header.frame_id = t.topic;
+  m.orientation.w = 1.0;
+  m.angular_velocity.x = t.gyro[k][0];
+  m.angular_velocity.y = t.gyro[k][1];
+  m.angular_velocity.z = t.gyro[k][2];
+  m.linear_acceleration.z = 9.81;
+  return m;
+}
+
 }  // namespace
 
 void write_recording(const std::string& dir, bool extra_topic) {
@@ -130,19 +144,69 @@ void write_imu_bag(const std::string& file, const std::vector<ImuTopic>& topics)
   std::sort(order.begin(), order.end());
   rosbag::Bag out(file, rosbag::bagmode::Write);
   out.setCompression(rosbag::compression::LZ4);
-  for (const auto& [stamp_ns, t, k] : order) {
-    sensor_msgs::Imu m;
-    m.header.stamp = ros_time(stamp_ns);
-    m.header.seq = static_cast<uint32_t>(k);
-    m.header.frame_id = topics[t].topic;
-    m.orientation.w = 1.0;
-    m.angular_velocity.x = topics[t].gyro[k][0];
-    m.angular_velocity.y = topics[t].gyro[k][1];
-    m.angular_velocity.z = topics[t].gyro[k][2];
-    m.linear_acceleration.z = 9.81;
-    out.write(topics[t].topic, ros_time(stamp_ns + kRecordDelay_ns), m);
-  }
+  for (const auto& [stamp_ns, t, k] : order)
+    out.write(topics[t].topic, ros_time(stamp_ns + kRecordDelay_ns), gyro_message(topics[t], k));
   out.close();
+}
+
+void write_split_bags(const std::string& stem, const Recording& r) {
+  int64_t first_ns = INT64_MAX, last_ns = INT64_MIN;
+  auto span = [&](int64_t ns) {
+    first_ns = std::min(first_ns, ns), last_ns = std::max(last_ns, ns);
+  };
+  for (const ImageMessage& m : r.images) span(m.stamp_ns);
+  for (const CloudMessage& m : r.clouds) span(m.stamp_ns);
+  for (const ImuTopic& t : r.imus)
+    for (const int64_t ns : t.stamps_ns) span(ns);
+  const int64_t split_ns = first_ns + (last_ns - first_ns) / 2;
+  rosbag::Bag first(stem + "_0.bag", rosbag::bagmode::Write);
+  first.setCompression(rosbag::compression::LZ4);
+  rosbag::Bag second(stem + "_1.bag", rosbag::bagmode::Write);
+  second.setCompression(rosbag::compression::BZ2);
+  auto write = [&](const std::string& topic, int64_t stamp_ns, const auto& message) {
+    (stamp_ns < split_ns ? first : second)
+        .write(topic, ros_time(stamp_ns + kRecordDelay_ns), message);
+  };
+  // As a recorder does: in time order over every topic (a time-ordered read of a bag written
+  // topic after topic decompresses a chunk per message).
+  std::vector<std::tuple<int64_t, int, size_t, size_t>> order;  // stamp, kind, index, sample
+  for (size_t i = 0; i < r.images.size(); ++i) order.emplace_back(r.images[i].stamp_ns, 0, i, 0);
+  for (size_t i = 0; i < r.clouds.size(); ++i) order.emplace_back(r.clouds[i].stamp_ns, 1, i, 0);
+  for (size_t i = 0; i < r.imus.size(); ++i)
+    for (size_t k = 0; k < r.imus[i].stamps_ns.size(); ++k)
+      order.emplace_back(r.imus[i].stamps_ns[k], 2, i, k);
+  std::sort(order.begin(), order.end());
+  for (const auto& [stamp_ns, kind, i, k] : order) {
+    if (kind == 0) {
+      const ImageMessage& image = r.images[i];
+      sensor_msgs::Image m;
+      m.header.stamp = ros_time(image.stamp_ns);
+      m.header.frame_id = image.topic;
+      m.width = image.width, m.height = image.height;
+      m.encoding = image.encoding;
+      m.step = static_cast<uint32_t>(image.data.size() / std::max(image.height, 1));
+      m.data = image.data;
+      write(image.topic, stamp_ns, m);
+    } else if (kind == 1) {
+      const CloudMessage& cloud = r.clouds[i];
+      sensor_msgs::PointCloud2 m;
+      m.header.stamp = ros_time(cloud.stamp_ns);
+      m.header.frame_id = "os_sensor";
+      ros_msgs::add_ouster_fields(m);
+      m.point_step = kPointStep;
+      m.height = 1;
+      m.width = static_cast<uint32_t>(cloud.records.size() / kPointStep);
+      m.row_step = m.width * kPointStep;
+      m.is_bigendian = false;
+      m.is_dense = true;
+      m.data = cloud.records;
+      write(cloud.topic, stamp_ns, m);
+    } else {
+      write(r.imus[i].topic, stamp_ns, gyro_message(r.imus[i], k));
+    }
+  }
+  first.close();
+  second.close();
 }
 
 }  // namespace rigcal::testing::bag

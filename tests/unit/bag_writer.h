@@ -65,4 +65,27 @@ struct ImuTopic {
 // their stamps.
 void write_imu_bag(const std::string& file, const std::vector<ImuTopic>& topics);
 
+// Any recording as messages: images (rows unpadded, `encoding` as ROS names it), clouds of the
+// Ouster driver's 48-byte records (add_ouster_fields, one row), gyro logs.
+struct ImageMessage {
+  std::string topic;
+  int64_t stamp_ns = 0;
+  int width = 0, height = 0;
+  std::string encoding;
+  std::vector<uint8_t> data;
+};
+struct CloudMessage {
+  std::string topic;
+  int64_t stamp_ns = 0;
+  std::vector<uint8_t> records;
+};
+struct Recording {
+  std::vector<ImageMessage> images;
+  std::vector<CloudMessage> clouds;
+  std::vector<ImuTopic> imus;
+};
+// Writes `r` as two bags split at the middle of its time span: <stem>_0.bag (LZ4, the earlier
+// half) and <stem>_1.bag (BZ2), every message recorded 1 ms after its header stamp.
+void write_split_bags(const std::string& stem, const Recording& r);
+
 }  // namespace rigcal::testing::bag

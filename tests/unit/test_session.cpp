@@ -13,17 +13,20 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "bag_writer.h"
 #include "cli_run.h"
 #include "devkit_layout.h"
 #include "fixtures.h"
 #include "rigcal/core/error.h"
 #include "rigcal/core/sha256.h"
 #include "rigcal/io/files.h"
+#include "rigcal/io/image_sets.h"
 #include "rigcal/io/rates_io.h"
 #include "rigcal/io/session.h"
 #include "rigcal/rig/rig_yaml.h"
@@ -449,6 +452,105 @@ TEST_F(Session, OnlyFromAndAnUndeterminedStep) {
   EXPECT_NE(u.out.find("== time_sync: undetermined"), std::string::npos) << u.out;
   EXPECT_NE(u.out.find("not enough excitation"), std::string::npos) << u.out;
   EXPECT_NE(u.out.find("what would settle it: record the two IMUs"), std::string::npos) << u.out;
+}
+
+// A recording in the devkit layout as the messages the rig's drivers publish, under the topic
+// names vbr-devkit maps back to the same folders: images as stored (bgr8, mono8 or mono16), the
+// Ouster driver's point records, the gyro logs.
+testing::bag::Recording recording_messages(const fs::path& recording) {
+  const std::map<std::string, std::string> topics = {{"camera_left", "/camera_left/image_raw"},
+                                                     {"camera_right", "/camera_right/image_raw"},
+                                                     {"ouster_points", "/ouster/points"},
+                                                     {"imu", "/imu/data"},
+                                                     {"ouster_imu", "/ouster/imu"}};
+  testing::bag::Recording r;
+  for (const auto& [folder, topic] : topics) {
+    const fs::path d = recording / folder;
+    if (!fs::exists(d / "timestamps.txt")) continue;
+    if (fs::exists(d / "data" / "imu.txt")) {
+      const io::RateFile f = io::read_rates(d);
+      testing::bag::ImuTopic t{topic, {}, {}};
+      for (size_t k = 0; k < f.rates.stamps.size(); ++k) {
+        t.stamps_ns.push_back(f.rates.stamps[k].ns);
+        t.gyro.push_back({f.rates.rates[k].x(), f.rates.rates[k].y(), f.rates.rates[k].z()});
+      }
+      r.imus.push_back(std::move(t));
+    } else if (folder == "ouster_points") {
+      const io::StampedFolder s = io::read_stamped_folder(d, ".bin");
+      for (size_t k = 0; k < s.files.size(); ++k) {
+        const std::string bytes = slurp(s.files[k]);
+        r.clouds.push_back({topic, s.stamps[k].ns, {bytes.begin(), bytes.end()}});
+      }
+    } else {
+      const io::StampedFolder s = io::read_stamped_folder(d, ".png");
+      for (size_t k = 0; k < s.files.size(); ++k) {
+        const cv::Mat img = cv::imread(s.files[k], cv::IMREAD_UNCHANGED);
+        if (img.empty() || !img.isContinuous()) throw std::runtime_error("cannot read " + s.files[k]);
+        const std::string encoding = img.channels() == 3      ? "bgr8"
+                                     : img.depth() == CV_16U ? "mono16"
+                                                              : "mono8";
+        r.images.push_back({topic, s.stamps[k].ns, img.cols, img.rows, encoding,
+                            {img.data, img.data + img.total() * img.elemSize()}});
+      }
+    }
+  }
+  return r;
+}
+
+// The whole session as the rig records it: its three recordings written as ROS1 bags, each split
+// in an LZ4 and a BZ2 bag. `rigcal calibrate` on the folders of bags directly gives the
+// calibration it gives on their `rigcal convert` conversions and on the original folders, to the
+// last digit of every value; the provenance names the folders of bags; nothing is left in TMPDIR.
+TEST_F(Session, CalibrateOnBagsIsCalibrateOnTheirConversionAndOnTheFolders) {
+  const fs::path original = whole_session();
+  const fs::path bags = dir_ / "bags", converted = dir_ / "converted", tmp = dir_ / "tmp";
+  fs::create_directories(tmp);
+  const std::string session_yaml =
+      "target: target.yaml\ncameras: stereo\nlidar_camera: lidar_camera\nmotion: motion\n"
+      "odometry: trajectories/lidar_odometry.tum\ngnss: trajectories/gnss_ins.tum\n";
+  for (const fs::path& root : {bags, converted}) {
+    fs::create_directories(root / "trajectories");
+    fs::copy_file(original / "target.yaml", root / "target.yaml");
+    for (const char* t : {"lidar_odometry.tum", "gnss_ins.tum"})
+      fs::copy_file(original / "trajectories" / t, root / "trajectories" / t);
+    std::ofstream(root / "session.yaml") << session_yaml;
+  }
+  for (const std::string rec : {"stereo", "lidar_camera", "motion"}) {
+    fs::create_directories(bags / rec);
+    const testing::bag::Recording messages =
+        recording_messages(rec == "motion" ? original : original / rec);
+    ASSERT_FALSE(messages.images.empty() && messages.clouds.empty() && messages.imus.empty())
+        << rec;
+    testing::bag::write_split_bags((bags / rec / rec).string(), messages);
+    const CliRun c = rigcal_cli(
+        fmt::format("convert {0}/{1}_0.bag {0}/{1}_1.bag --out {2}", (bags / rec).string(), rec,
+                    (converted / rec).string()),
+        dir_);
+    ASSERT_EQ(c.status, 0) << c.out << c.err;
+  }
+  auto calibrate = [&](const fs::path& session, const std::string& name) {
+    const fs::path out = dir_ / ("out_" + name);
+    const CliRun r = rigcal_cli(
+        fmt::format("calibrate {} --out {} --rig {}", session.string(), out.string(), kPrior),
+        dir_, fmt::format("TMPDIR={}", tmp.string()));
+    EXPECT_EQ(r.status, 0) << name << "\n" << r.out << r.err;
+    std::printf("[ figures ] calibrate on the %s: %.1f s\n", name.c_str(), r.seconds);
+    return slurp(out / "calib.yaml");
+  };
+  const std::string on_bags = calibrate(bags, "bags");
+  EXPECT_TRUE(fs::is_empty(tmp));
+  const std::string on_conversion = calibrate(converted, "conversion");
+  const std::string on_original = calibrate(original, "original");
+  // Everything before the provenance: every sensor's values as printed.
+  auto values = [](const std::string& yaml) { return yaml.substr(0, yaml.find("\nrigcal:")); };
+  ASSERT_NE(values(on_bags).find("T_b"), std::string::npos) << on_bags;
+  EXPECT_EQ(values(on_bags), values(on_conversion));
+  EXPECT_EQ(values(on_bags), values(on_original));
+  // The inputs as the user knows them: the folder of bags and the topic in it, not $TMPDIR.
+  for (const fs::path& p : {bags / "stereo" / "camera_left", bags / "lidar_camera" / "ouster_points",
+                            bags / "motion" / "ouster_imu"})
+    EXPECT_NE(on_bags.find("path: " + p.string() + ","), std::string::npos) << p << "\n" << on_bags;
+  EXPECT_EQ(on_bags.find(tmp.string()), std::string::npos) << on_bags;
 }
 
 TEST(Publish, RefusesAnUnknownCalibrationAndReplacesWithForce) {
