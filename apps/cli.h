@@ -61,6 +61,8 @@ void add_calibrate(CLI::App& app);
 void add_publish(CLI::App& app);
 // `rigcal convert`
 void add_convert(CLI::App& app);
+// `rigcal odometry`
+void add_odometry(CLI::App& app);
 // `rigcal target print`
 void add_target_print(CLI::App& target);
 

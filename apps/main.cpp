@@ -47,6 +47,7 @@ int main(int argc, char** argv) {
   rigcal::cli::add_time_offset(app);
   rigcal::cli::add_hand_eye(app);
   rigcal::cli::add_lidar_camera(app);
+  rigcal::cli::add_odometry(app);
   CLI::App* target = app.add_subcommand("target", "Calibration targets: printable PDFs");
   target->require_subcommand(1);
   rigcal::cli::add_target_print(*target);

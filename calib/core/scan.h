@@ -25,6 +25,7 @@ struct ScanPoint {
 struct Scan {
   Time stamp;  // on the sensor's clock: the time every point's t_ns counts from
   std::vector<ScanPoint> points;
+  bool point_times = true;  // false: the source had no per-point times (every t_ns is 0)
 };
 
 }  // namespace rigcal

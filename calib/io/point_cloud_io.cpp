@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -116,8 +117,13 @@ std::vector<Field> vbr_fields(const std::filesystem::path& bin, size_t& point_st
   return fields;
 }
 
+bool no_return(double x, double y, double z) {
+  return !std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z) ||
+         (x == 0 && y == 0 && z == 0);
+}
+
 // KITTI points, or vbr-devkit's full records where its metadata describes them.
-std::vector<Eigen::Vector3d> read_bin(const std::filesystem::path& path) {
+Scan read_bin(const std::filesystem::path& path, bool sidecar_times) {
   const std::string data = read_text_file(path);  // binary-safe: one read of the whole file
   size_t step = 16;
   const std::vector<Field> fields = vbr_fields(path, step);
@@ -126,7 +132,9 @@ std::vector<Eigen::Vector3d> read_bin(const std::filesystem::path& path) {
       if (f.name == name) return &f;
     return nullptr;
   };
-  const Field *fx = find("x"), *fy = find("y"), *fz = find("z"), *ring = find("ring");
+  const Field *fx = find("x"), *fy = find("y"), *fz = find("z"), *ring = find("ring"),
+              *ft = find("t"), *fi = find("intensity"), *fr = find("reflectivity"),
+              *frange = find("range");
   // Full records? Both layouts may divide the file's size; the wrong one shows itself: KITTI
   // records read from full ones hold the driver's integer fields as tiny non-zero floats, full
   // records read from KITTI ones have rings in the tens of thousands.
@@ -162,14 +170,27 @@ std::vector<Eigen::Vector3d> read_bin(const std::filesystem::path& path) {
           path.string(), step));
     }
   }
-  std::vector<Eigen::Vector3d> out;
+  Scan scan;
   if (full) {
-    out.reserve(data.size() / step);
+    scan.point_times = ft != nullptr;
+    scan.points.reserve(data.size() / step);
     for (size_t k = 0; k < data.size(); k += step) {
       const char* r = data.data() + k;
-      keep(out, field_value(r, *fx), field_value(r, *fy), field_value(r, *fz));
+      const double x = field_value(r, *fx), y = field_value(r, *fy), z = field_value(r, *fz);
+      if (no_return(x, y, z)) continue;
+      ScanPoint p;
+      p.p = Eigen::Vector3d(x, y, z).cast<float>();
+      if (ft) {
+        const double t = field_value(r, *ft);
+        p.t_ns = static_cast<int64_t>(ft->datatype >= 7 ? std::llround(t * 1e9) : t);
+      }
+      if (fi) p.intensity = static_cast<float>(field_value(r, *fi));
+      if (ring) p.ring = static_cast<uint16_t>(field_value(r, *ring));
+      if (fr) p.reflectivity = static_cast<uint16_t>(std::clamp(field_value(r, *fr), 0.0, 65535.0));
+      if (frange) p.range_mm = static_cast<uint32_t>(std::max(field_value(r, *frange), 0.0));
+      scan.points.push_back(p);
     }
-    return out;
+    return scan;
   }
   if (data.size() % 16 != 0) {
     throw Error(fmt::format(
@@ -178,13 +199,37 @@ std::vector<Eigen::Vector3d> read_bin(const std::filesystem::path& path) {
         fields.empty() ? ""
                        : fmt::format(" nor of {}-byte records of the metadata's fields", step)));
   }
-  out.reserve(data.size() / 16);
+  // rigcal's simulator: t and ring of every point in fields/ beside data/, 8 bytes a point.
+  const std::filesystem::path sidecar =
+      path.parent_path().parent_path() / "fields" / path.filename();
+  std::string sidecar_data;
+  if (sidecar_times && path.parent_path().filename() == "data" &&
+      std::filesystem::exists(sidecar)) {
+    sidecar_data = read_text_file(sidecar);
+    if (sidecar_data.size() != data.size() / 2) {
+      throw Error(fmt::format("{}: {} bytes for the {} points of {} (8 bytes a point)",
+                              sidecar.string(), sidecar_data.size(), data.size() / 16,
+                              path.string()));
+    }
+  }
+  scan.point_times = !sidecar_data.empty();
+  scan.points.reserve(data.size() / 16);
   for (size_t k = 0; k < data.size(); k += 16) {
     float v[4];
     std::memcpy(v, data.data() + k, 16);
-    keep(out, v[0], v[1], v[2]);
+    if (no_return(v[0], v[1], v[2])) continue;
+    ScanPoint p;
+    p.p = Eigen::Vector3f(v[0], v[1], v[2]);
+    p.intensity = v[3];
+    if (!sidecar_data.empty()) {
+      uint32_t t;
+      std::memcpy(&t, sidecar_data.data() + k / 2, 4);
+      std::memcpy(&p.ring, sidecar_data.data() + k / 2 + 4, 2);
+      p.t_ns = t;
+    }
+    scan.points.push_back(p);
   }
-  return out;
+  return scan;
 }
 
 std::vector<Eigen::Vector3d> read_pcd(const std::filesystem::path& path) {
@@ -323,11 +368,28 @@ std::vector<Eigen::Vector3d> read_pcd(const std::filesystem::path& path) {
 
 }  // namespace
 
+Scan read_scan(const std::filesystem::path& path) {
+  const std::string ext = path.extension().string();
+  if (ext == ".bin") return read_bin(path, true);
+  if (ext == ".pcd") {
+    Scan scan;
+    scan.point_times = false;
+    for (const Eigen::Vector3d& p : read_pcd(path)) scan.points.push_back({.p = p.cast<float>()});
+    return scan;
+  }
+  throw Error(fmt::format("{}: unknown point cloud extension (.bin or .pcd)", path.string()));
+}
+
 std::vector<Eigen::Vector3d> read_point_cloud(const std::filesystem::path& path) {
   const std::string ext = path.extension().string();
-  if (ext == ".bin") return read_bin(path);
   if (ext == ".pcd") return read_pcd(path);
-  throw Error(fmt::format("{}: unknown point cloud extension (.bin or .pcd)", path.string()));
+  if (ext != ".bin")
+    throw Error(fmt::format("{}: unknown point cloud extension (.bin or .pcd)", path.string()));
+  const Scan scan = read_bin(path, false);
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(scan.points.size());
+  for (const ScanPoint& p : scan.points) out.push_back(p.p.cast<double>());
+  return out;
 }
 
 }  // namespace rigcal::io

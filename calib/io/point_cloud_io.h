@@ -11,6 +11,8 @@
 #include <filesystem>
 #include <vector>
 
+#include "rigcal/core/scan.h"
+
 namespace rigcal::io {
 
 // A topic's .metadata.json is a few hundred bytes (the fields of one message type); a larger one
@@ -19,5 +21,13 @@ inline constexpr size_t kMaxMetadataBytes = 1 << 20;
 
 // By extension: .bin (KITTI) or .pcd. Throws rigcal::Error naming the file and what is wrong.
 std::vector<Eigen::Vector3d> read_point_cloud(const std::filesystem::path& path);
+
+// The same files as scans with what they hold per point: full records give `t` (the Ouster
+// driver's uint32 ns since the sweep's start; a float `t` is seconds), `ring`, `intensity`,
+// `reflectivity`, `range` (mm) where their fields exist; KITTI points give intensity, and the
+// times and rings of rigcal's simulator where its fields/ sidecar (doc/simulator.md) is beside
+// data/; PCD gives x y z. Without times, Scan::point_times is false. The stamp is left 0 (the
+// caller knows it from timestamps.txt). Points with no return are dropped as above.
+Scan read_scan(const std::filesystem::path& path);
 
 }  // namespace rigcal::io

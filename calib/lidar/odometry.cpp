@@ -1,0 +1,152 @@
+#include "rigcal/lidar/odometry.h"
+
+#include <fmt/format.h>
+
+#include <Eigen/Eigenvalues>
+#include <chrono>
+#include <cmath>
+
+#include "rigcal/core/error.h"
+#include "rigcal/lidar/preprocess.h"
+
+namespace rigcal::lidar {
+namespace {
+
+// `covariance` in the previous sensor frame; the information's eigenvalues are those of any frame.
+Degeneracy degeneracy_of(const Matrix6d& covariance, const Matrix6d& information, double ratio) {
+  Degeneracy d;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> rot(covariance.topLeftCorner<3, 3>()),
+      trans(covariance.bottomRightCorner<3, 3>());
+  d.rotation_sigma_max_deg = std::sqrt(std::max(rot.eigenvalues()(2), 0.0)) * 180.0 / M_PI;
+  d.weakest_rotation = rot.eigenvectors().col(2);
+  d.translation_sigma_max_m = std::sqrt(std::max(trans.eigenvalues()(2), 0.0));
+  d.weakest_translation = trans.eigenvectors().col(2);
+  auto block_ratio = [](const Eigen::Matrix3d& block) {
+    const Eigen::Vector3d l = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(block).eigenvalues();
+    return l(2) > 0 ? std::max(l(0), 0.0) / l(2) : 0.0;
+  };
+  d.rotation_ratio = block_ratio(information.topLeftCorner<3, 3>());
+  d.translation_ratio = block_ratio(information.bottomRightCorner<3, 3>());
+  d.degenerate = d.rotation_ratio < ratio || d.translation_ratio < ratio;
+  return d;
+}
+
+}  // namespace
+
+OdometryConfig os0_128_handheld() {
+  OdometryConfig c;
+  c.voxel_size_m = 0.5, c.max_range_m = 50.0, c.min_range_m = 0.5;
+  return c;
+}
+
+OdometryConfig os1_64_car() {
+  OdometryConfig c;
+  c.voxel_size_m = 1.0, c.max_range_m = 100.0, c.min_range_m = 1.0;
+  return c;
+}
+
+OdometryConfig odometry_preset(const std::string& name) {
+  if (name == "os0-128") return os0_128_handheld();
+  if (name == "os1-64") return os1_64_car();
+  throw Error(fmt::format("unknown sensor preset '{}' (os0-128 or os1-64)", name));
+}
+
+Odometry start_odometry(const OdometryConfig& config) {
+  Odometry o;
+  o.config = config;
+  o.map.voxel_size = config.voxel_size_m;
+  o.map.max_points_per_voxel = config.max_points_per_voxel;
+  o.threshold.initial_m = config.initial_threshold_m;
+  o.threshold.min_motion_m = config.min_motion_m;
+  o.threshold.max_range_m = config.max_range_m;
+  return o;
+}
+
+Step register_scan(Odometry& o, const Scan& scan) {
+  const auto started = std::chrono::steady_clock::now();
+  const OdometryConfig& c = o.config;
+  Trajectory& poses = o.T_odom_lidar;
+  if (!poses.empty() && scan.stamp <= poses.stamps.back()) {
+    throw Error(fmt::format("scan stamped {} s is not after the previous one ({} s)",
+                            scan.stamp.seconds(), poses.stamps.back().seconds()));
+  }
+  Step step;
+  step.stamp = scan.stamp;
+  step.points_in = scan.points.size();
+  // Constant velocity: the last motion, scaled to this scan's time step.
+  SE3 T_prev_cur_predicted;
+  double period_s = 0;
+  const size_t n = poses.size();
+  if (n >= 1) period_s = (scan.stamp - poses.stamps[n - 1]).seconds();
+  if (n >= 2) {
+    const double last_s = (poses.stamps[n - 1] - poses.stamps[n - 2]).seconds();
+    T_prev_cur_predicted = motion_fraction(
+        poses.T_world_body[n - 2].inverse() * poses.T_world_body[n - 1], period_s / last_s);
+  }
+  const SE3 T_odom_prev = n >= 1 ? poses.T_world_body[n - 1] : SE3::identity();
+  const SE3 T_odom_predicted = T_odom_prev * T_prev_cur_predicted;
+  // The motion over this sweep is taken as the motion from the previous stamp to this one: first
+  // the prediction (none for the second scan), then the estimate. The first scan is deskewed
+  // once the second has been registered (below).
+  const bool deskew = c.deskew && scan.point_times && n >= 1;
+  auto points_at = [&](const SE3& T_cur_next) {
+    return deskewed_points(scan, deskew ? T_cur_next : SE3::identity(), period_s, c.min_range_m,
+                           c.max_range_m);
+  };
+  std::vector<Eigen::Vector3d> frame =
+      voxel_downsample(points_at(T_prev_cur_predicted), 0.5 * c.voxel_size_m);
+  std::vector<Eigen::Vector3d> source = voxel_downsample(frame, 1.5 * c.voxel_size_m);
+  step.points_used = source.size();
+  step.deskewed = deskew;
+  SE3 T_odom_cur = T_odom_predicted;
+  if (n >= 1) {
+    const double sigma = sigma_m(o.threshold);
+    step.threshold_m = 3.0 * sigma;
+    auto registered = [&](const SE3& T_guess, const SE3& T_prev_cur_motion) {
+      frame = voxel_downsample(points_at(T_prev_cur_motion), 0.5 * c.voxel_size_m);
+      source = voxel_downsample(frame, 1.5 * c.voxel_size_m);
+      return register_points(source, o.map, T_guess, 3.0 * sigma, sigma / 3.0, c.registration);
+    };
+    Registration r =
+        register_points(source, o.map, T_odom_predicted, 3.0 * sigma, sigma / 3.0, c.registration);
+    for (int pass = 1; deskew && pass < c.deskew_passes && r.correspondences >= 6; ++pass)
+      r = registered(r.T_odom_lidar, T_odom_prev.inverse() * r.T_odom_lidar);
+    // The second scan: the first one deskewed with the motion now known, the map rebuilt from
+    // it, and the second registered again (twice: the motion improves with the map).
+    for (int pass = 0; deskew && n == 1 && o.first_scan.point_times && pass < 2; ++pass) {
+      o.map.voxels.clear();
+      add_points(o.map, voxel_downsample(deskewed_points(o.first_scan, r.T_odom_lidar, period_s,
+                                                         c.min_range_m, c.max_range_m),
+                                         0.5 * c.voxel_size_m));
+      r = registered(r.T_odom_lidar, r.T_odom_lidar);
+    }
+    if (n == 1) o.first_scan = Scan{};
+    step.points_used = source.size();
+    T_odom_cur = r.T_odom_lidar;
+    update(o.threshold, T_odom_predicted.inverse() * T_odom_cur);
+    // The covariance of T_odom_cur, the map (the previous poses) held: in the previous frame.
+    Matrix6d A = Matrix6d::Zero();
+    A.topLeftCorner<3, 3>() = A.bottomRightCorner<3, 3>() = T_odom_prev.R.transpose();
+    step.covariance_prev_cur = A * r.covariance * A.transpose();
+    step.degeneracy = degeneracy_of(step.covariance_prev_cur, r.information, c.degenerate_ratio);
+    step.correspondences = r.correspondences;
+    step.residual_rms_m = r.residual_rms_m;
+    step.noise_sigma_m = r.noise_sigma_m;
+    step.iterations = r.iterations;
+    step.converged = r.converged;
+  } else {
+    o.first_scan = scan;
+  }
+  step.T_odom_lidar = T_odom_cur;
+  std::vector<Eigen::Vector3d> frame_odom;
+  frame_odom.reserve(frame.size());
+  for (const Eigen::Vector3d& p : frame) frame_odom.push_back(T_odom_cur * p);
+  add_points(o.map, frame_odom);
+  remove_far(o.map, T_odom_cur.t, c.max_range_m);
+  poses.stamps.push_back(scan.stamp);
+  poses.T_world_body.push_back(T_odom_cur);
+  step.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return step;
+}
+
+}  // namespace rigcal::lidar

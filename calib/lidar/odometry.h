@@ -1,0 +1,76 @@
+#pragma once
+// The LiDAR odometry of rigcal (doc/odometry.md): point-to-plane ICP of each deskewed sweep
+// against a local voxel map, in the shape of KISS-ICP's pipeline, with the covariance and the
+// degeneracy of every step. Each pose is the sensor's at the scan's stamp (the sweep's first
+// point, Scan::stamp), the convention of VBR's ground truth.
+#include <string>
+#include <vector>
+
+#include "rigcal/core/scan.h"
+#include "rigcal/core/se3.h"
+#include "rigcal/core/trajectory.h"
+#include "rigcal/lidar/registration.h"
+#include "rigcal/lidar/threshold.h"
+#include "rigcal/lidar/voxel_map.h"
+
+namespace rigcal::lidar {
+
+struct OdometryConfig {
+  double voxel_size_m = 1.0;  // the map's voxels; the sweep is sampled at 0.5 and 1.5 of it
+  double min_range_m = 0.5, max_range_m = 100.0;
+  size_t max_points_per_voxel = 20;
+  double initial_threshold_m = 2.0, min_motion_m = 0.1;
+  bool deskew = true;
+  int deskew_passes = 2;  // 2: deskew again with the estimated motion and refine
+  RegistrationConfig registration;
+  // A step is called degenerate when the information's weakest direction holds less than this
+  // fraction of its strongest (translation and rotation blocks separately).
+  double degenerate_ratio = 0.01;
+};
+// Presets for the Ouster models of the VBR rig.
+OdometryConfig os0_128_handheld();  // 10 Hz, indoor and outdoor on foot: 0.5 m voxels, 50 m
+OdometryConfig os1_64_car();        // 20 Hz, streets: 1.0 m voxels, 100 m
+// "os0-128" | "os1-64"; throws rigcal::Error naming the choices otherwise.
+OdometryConfig odometry_preset(const std::string& name);
+
+// How well a step's registration constrains each direction: from its relative covariance, the
+// largest translation and rotation sigmas and their directions, and the information's weakest
+// over strongest eigenvalue per block.
+struct Degeneracy {
+  double translation_sigma_max_m = 0, rotation_sigma_max_deg = 0;
+  Eigen::Vector3d weakest_translation = Eigen::Vector3d::Zero();  // unit, previous sensor frame
+  Eigen::Vector3d weakest_rotation = Eigen::Vector3d::Zero();
+  double translation_ratio = 0, rotation_ratio = 0;
+  bool degenerate = false;
+};
+
+struct Step {
+  Time stamp;
+  SE3 T_odom_lidar;
+  // Covariance of the relative motion T_prev_cur = T_odom_lidar(prev)^-1 T_odom_lidar(cur) in
+  // rigcal's tangent (rotation first, left perturbation, the previous sensor frame), rad and m.
+  // Zero for the first scan.
+  Matrix6d covariance_prev_cur = Matrix6d::Zero();
+  Degeneracy degeneracy;
+  size_t points_in = 0, points_used = 0, correspondences = 0;
+  double residual_rms_m = 0, noise_sigma_m = 0, threshold_m = 0;
+  int iterations = 0;
+  bool converged = false, deskewed = false;
+  double seconds = 0;  // wall time of the step
+};
+
+struct Odometry {
+  OdometryConfig config;
+  VoxelMap map;
+  AdaptiveThreshold threshold;
+  Trajectory T_odom_lidar;  // one pose a registered scan
+  Scan first_scan;          // kept until the second scan gives the motion to deskew it
+};
+
+Odometry start_odometry(const OdometryConfig& config);
+// Registers the next scan (stamps strictly increasing; throws rigcal::Error otherwise). The first
+// scan starts the map as measured; the second's registration gives the motion that deskews it,
+// and the map is then rebuilt from both.
+Step register_scan(Odometry& odometry, const Scan& scan);
+
+}  // namespace rigcal::lidar

@@ -1,0 +1,44 @@
+#pragma once
+// Point-to-plane ICP of a sweep against the local map (doc/odometry.md): Gauss-Newton on
+// r_i = n_i . (T_odom_lidar p_i - m_i), the plane (n_i, m_i) through the map points nearest the
+// moved point, a Geman-McClure kernel of scale `kernel_m`, correspondences within
+// `max_correspondence_m`. Its information and the residuals' noise level give the pose's
+// covariance.
+#include <Eigen/Core>
+#include <vector>
+
+#include "rigcal/core/se3.h"
+#include "rigcal/lidar/voxel_map.h"
+
+namespace rigcal::lidar {
+
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+
+struct RegistrationConfig {
+  int max_iterations = 50;
+  double convergence = 1e-4;  // stop when the step (rad and m together) is below this
+  int plane_neighbours = 8;   // map points a plane is fitted to
+  double max_flatness = 0.1;  // smallest over middle scatter eigenvalue of a plane's points
+};
+
+struct Registration {
+  SE3 T_odom_lidar;
+  // sum of w_i J_i^T J_i at the solution, J_i = d r_i / d(rotation, translation) in rigcal's
+  // tangent (rotation first, left perturbation: R' = exp(d_rot) R, t' = t + d_t); units 1, m, m^2.
+  Matrix6d information = Matrix6d::Zero();
+  // sqrt(sum w r^2 / (sum w - 6)): the residuals' noise level, m.
+  double noise_sigma_m = 0;
+  // covariance of T_odom_lidar in that tangent: noise_sigma^2 * information^-1 (rad, m).
+  Matrix6d covariance = Matrix6d::Zero();
+  size_t points = 0, correspondences = 0;
+  double residual_rms_m = 0;  // over the correspondences, unweighted
+  int iterations = 0;
+  bool converged = false;
+};
+
+// Too few correspondences (fewer than 6 planes) leave the guess unchanged with converged false.
+Registration register_points(const std::vector<Eigen::Vector3d>& points_lidar, const VoxelMap& map,
+                             const SE3& T_odom_lidar_guess, double max_correspondence_m,
+                             double kernel_m, const RegistrationConfig& config);
+
+}  // namespace rigcal::lidar

@@ -1,0 +1,133 @@
+#include "rigcal/lidar/step.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+
+#include "rigcal/core/error.h"
+#include "rigcal/io/image_sets.h"
+#include "rigcal/io/point_cloud_io.h"
+#include "rigcal/io/session.h"
+
+namespace rigcal::lidar {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+bool is_scan_topic(const fs::path& folder) {
+  return fs::is_directory(folder / "data") && fs::exists(folder / "timestamps.txt");
+}
+
+std::string scan_extension(const fs::path& folder) {
+  for (const fs::directory_entry& e : fs::directory_iterator(folder / "data")) {
+    if (e.path().extension() == ".bin") return ".bin";
+    if (e.path().extension() == ".pcd") return ".pcd";
+  }
+  throw Error(fmt::format("{}: no .bin or .pcd scans in data/", folder.string()));
+}
+
+}  // namespace
+
+fs::path scans_folder(const fs::path& given, const report::Progress& progress) {
+  if (fs::is_directory(given) && is_scan_topic(given) && !fs::exists(given / "ouster_points"))
+    return given;
+  if (is_scan_topic(given / "ouster_points")) return given / "ouster_points";
+  const io::Session s = io::read_session(given, progress);
+  for (const fs::path& recording : {s.motion, s.lidar_camera}) {
+    if (!recording.empty() && is_scan_topic(recording / "ouster_points"))
+      return recording / "ouster_points";
+  }
+  throw Error(fmt::format(
+      "{}: no scans (a folder with data/ and timestamps.txt, a recording with ouster_points/, "
+      "or a session whose motion or lidar_camera recording has one)",
+      given.string()));
+}
+
+OdometryRun run_odometry(const fs::path& scans, const OdometryConfig& config,
+                         const report::Progress& progress) {
+  const auto started = std::chrono::steady_clock::now();
+  OdometryRun run;
+  run.scans = scans;
+  run.config = config;
+  const io::StampedFolder folder = io::read_stamped_folder(scans, scan_extension(scans));
+  Odometry odometry = start_odometry(config);
+  size_t without_times = 0;
+  for (size_t k = 0; k < folder.files.size(); ++k) {
+    Scan scan = io::read_scan(folder.files[k]);
+    scan.stamp = folder.stamps[k];
+    without_times += !scan.point_times;
+    run.steps.push_back(register_scan(odometry, scan));
+    report::tell(progress, "odometry: scans registered", k + 1, folder.files.size());
+  }
+  if (without_times > 0) {
+    run.notes.push_back(fmt::format(
+        "{} of {} scans have no per-point times (KITTI points, PCD): they are registered as "
+        "measured, not deskewed",
+        without_times, folder.files.size()));
+  }
+  run.T_odom_lidar = odometry.T_odom_lidar;
+  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return run;
+}
+
+nlohmann::json odometry_report(const OdometryRun& run) {
+  const OdometryConfig& c = run.config;
+  nlohmann::json j;
+  j["step"] = "odometry";
+  j["scans"] = run.scans.string();
+  j["config"] = {{"voxel_size_m", c.voxel_size_m},
+                 {"min_range_m", c.min_range_m},
+                 {"max_range_m", c.max_range_m},
+                 {"max_points_per_voxel", c.max_points_per_voxel},
+                 {"initial_threshold_m", c.initial_threshold_m},
+                 {"deskew", c.deskew},
+                 {"deskew_passes", c.deskew_passes},
+                 {"plane_neighbours", c.registration.plane_neighbours},
+                 {"degenerate_ratio", c.degenerate_ratio}};
+  size_t degenerate = 0, not_converged = 0;
+  double step_seconds = 0, max_seconds = 0;
+  nlohmann::json rows = nlohmann::json::array();
+  for (size_t k = 0; k < run.steps.size(); ++k) {
+    const Step& s = run.steps[k];
+    step_seconds += s.seconds, max_seconds = std::max(max_seconds, s.seconds);
+    if (k == 0) continue;
+    degenerate += s.degeneracy.degenerate;
+    not_converged += !s.converged;
+    const Degeneracy& d = s.degeneracy;
+    rows.push_back(
+        {{"t", s.stamp.seconds()},
+         {"points_in", s.points_in},
+         {"points_used", s.points_used},
+         {"correspondences", s.correspondences},
+         {"inlier_ratio", s.points_used ? double(s.correspondences) / s.points_used : 0},
+         {"residual_rms_m", s.residual_rms_m},
+         {"noise_sigma_m", s.noise_sigma_m},
+         {"threshold_m", s.threshold_m},
+         {"iterations", s.iterations},
+         {"converged", s.converged},
+         {"deskewed", s.deskewed},
+         {"translation_sigma_max_m", d.translation_sigma_max_m},
+         {"rotation_sigma_max_deg", d.rotation_sigma_max_deg},
+         {"weakest_translation",
+          {d.weakest_translation.x(), d.weakest_translation.y(), d.weakest_translation.z()}},
+         {"translation_ratio", d.translation_ratio},
+         {"rotation_ratio", d.rotation_ratio},
+         {"degenerate", d.degenerate},
+         {"seconds", s.seconds}});
+  }
+  j["summary"] = {
+      {"scans", run.steps.size()},
+      {"path_length_m", path_length(run.T_odom_lidar)},
+      {"degenerate_steps", degenerate},
+      {"not_converged_steps", not_converged},
+      {"seconds", run.seconds},
+      {"registration_seconds_mean", run.steps.empty() ? 0.0 : step_seconds / run.steps.size()},
+      {"registration_seconds_max", max_seconds}};
+  j["notes"] = run.notes;
+  j["steps"] = rows;
+  return j;
+}
+
+}  // namespace rigcal::lidar

@@ -1,0 +1,40 @@
+#pragma once
+// The odometry step (doc/odometry.md): the scans of a recording, streamed one at a time through
+// the odometry, with the trajectory, the per-step covariances and a report as the result.
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "rigcal/lidar/odometry.h"
+#include "rigcal/report/step.h"
+
+namespace rigcal::lidar {
+
+// The scans a path given by the user stands for: a topic folder itself (data/ with .bin or .pcd
+// and timestamps.txt), else its ouster_points/ (a recording), else the ouster_points/ of the
+// session's motion recording, then of its lidar_camera recording (io::read_session: bags and
+// captures are converted first). Throws rigcal::Error saying what was looked for.
+std::filesystem::path scans_folder(const std::filesystem::path& given,
+                                   const report::Progress& progress = {});
+
+struct OdometryRun {
+  std::filesystem::path scans;
+  OdometryConfig config;
+  Trajectory T_odom_lidar;
+  std::vector<Step> steps;
+  std::vector<std::string> notes;  // what the run assumed or could not do
+  double seconds = 0;
+};
+
+// Reads and registers every scan of `scans` in stamp order; the stamps of timestamps.txt are
+// taken as each sweep's first point, the time its per-point times count from. Throws
+// rigcal::Error naming the file on a scan not read.
+OdometryRun run_odometry(const std::filesystem::path& scans, const OdometryConfig& config,
+                         const report::Progress& progress = {});
+
+// The report: the configuration, a summary (frames, path length, timing, degenerate steps) and
+// one row a step (doc/odometry.md says what each number is).
+nlohmann::json odometry_report(const OdometryRun& run);
+
+}  // namespace rigcal::lidar

@@ -1,0 +1,82 @@
+#include "rigcal/lidar/voxel_map.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace rigcal::lidar {
+
+Eigen::Vector3i voxel_of(const Eigen::Vector3d& p, double voxel_size) {
+  return (p / voxel_size).array().floor().cast<int>();
+}
+
+size_t point_count(const VoxelMap& map) {
+  size_t n = 0;
+  for (const auto& [key, points] : map.voxels) n += points.size();
+  return n;
+}
+
+void add_points(VoxelMap& map, const std::vector<Eigen::Vector3d>& points_odom) {
+  for (const Eigen::Vector3d& p : points_odom) {
+    std::vector<Eigen::Vector3d>& voxel = map.voxels[voxel_of(p, map.voxel_size)];
+    if (voxel.size() < map.max_points_per_voxel) voxel.push_back(p);
+  }
+}
+
+void remove_far(VoxelMap& map, const Eigen::Vector3d& origin_odom, double max_distance) {
+  const double max_squared = max_distance * max_distance;
+  std::erase_if(map.voxels, [&](const auto& entry) {
+    return entry.second.empty() || (entry.second.front() - origin_odom).squaredNorm() > max_squared;
+  });
+}
+
+std::optional<Plane> plane_near(const VoxelMap& map, const Eigen::Vector3d& q, double max_distance,
+                                int neighbours, double max_flatness) {
+  constexpr int kMaxNeighbours = 16;
+  const int k_wanted = std::clamp(neighbours, 5, kMaxNeighbours);
+  // The k nearest, kept sorted by squared distance (insertion: k is small).
+  std::array<std::pair<double, const Eigen::Vector3d*>, kMaxNeighbours> nearest;
+  int k = 0;
+  const double max_squared = max_distance * max_distance;
+  const Eigen::Vector3i centre = voxel_of(q, map.voxel_size);
+  for (int dx = -1; dx <= 1; ++dx) {
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dz = -1; dz <= 1; ++dz) {
+        const auto it = map.voxels.find(centre + Eigen::Vector3i(dx, dy, dz));
+        if (it == map.voxels.end()) continue;
+        for (const Eigen::Vector3d& p : it->second) {
+          const double d2 = (p - q).squaredNorm();
+          if (d2 > max_squared || (k == k_wanted && d2 >= nearest[k - 1].first)) continue;
+          int at = k < k_wanted ? k++ : k - 1;
+          while (at > 0 && nearest[at - 1].first > d2) {
+            nearest[at] = nearest[at - 1];
+            --at;
+          }
+          nearest[at] = {d2, &p};
+        }
+      }
+    }
+  }
+  if (k < 5) return std::nullopt;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (int i = 0; i < k; ++i) mean += *nearest[i].second;
+  mean /= k;
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (int i = 0; i < k; ++i) {
+    const Eigen::Vector3d d = *nearest[i].second - mean;
+    scatter += d * d.transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
+  eigen.computeDirect(scatter);
+  const Eigen::Vector3d& lambda = eigen.eigenvalues();  // ascending
+  if (!(lambda(1) > 0)) return std::nullopt;
+  Plane plane;
+  plane.flatness = std::max(lambda(0), 0.0) / lambda(1);
+  if (plane.flatness > max_flatness) return std::nullopt;
+  plane.normal = eigen.eigenvectors().col(0).normalized();
+  plane.point = mean;
+  return plane;
+}
+
+}  // namespace rigcal::lidar

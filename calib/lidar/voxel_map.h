@@ -1,0 +1,47 @@
+#pragma once
+// The local map of the LiDAR odometry (doc/odometry.md): points in the odometry frame hashed into
+// cubic voxels, a few a voxel, the voxels beyond the sensor's reach dropped as it moves (the map
+// of KISS-ICP), and the plane through the map points nearest a query point, which gives the
+// point-to-plane residual.
+#include <Eigen/Core>
+#include <cstddef>
+#include <optional>
+#include <unordered_map>
+#include <vector>
+
+namespace rigcal::lidar {
+
+struct VoxelHash {
+  size_t operator()(const Eigen::Vector3i& v) const {
+    return static_cast<size_t>(v.x()) * 73856093u ^ static_cast<size_t>(v.y()) * 19349669u ^
+           static_cast<size_t>(v.z()) * 83492791u;
+  }
+};
+
+struct VoxelMap {
+  double voxel_size = 1.0;  // m
+  size_t max_points_per_voxel = 20;
+  std::unordered_map<Eigen::Vector3i, std::vector<Eigen::Vector3d>, VoxelHash> voxels;
+};
+
+Eigen::Vector3i voxel_of(const Eigen::Vector3d& p, double voxel_size);
+size_t point_count(const VoxelMap& map);
+// Adds points (odometry frame) to voxels not yet full.
+void add_points(VoxelMap& map, const std::vector<Eigen::Vector3d>& points_odom);
+// Drops the voxels whose first point is farther than `max_distance` from `origin_odom`.
+void remove_far(VoxelMap& map, const Eigen::Vector3d& origin_odom, double max_distance);
+
+// A plane through map points: unit normal, a point on it (their centroid), and how flat the
+// points lie (the smallest over the middle eigenvalue of their scatter, 0 for a perfect plane).
+struct Plane {
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  double flatness = 0;
+};
+// The plane through the `neighbours` map points nearest q within `max_distance` (searched in the
+// 27 voxels around q); none when fewer than 5 are found or they do not lie on a plane (flatness
+// over `max_flatness`).
+std::optional<Plane> plane_near(const VoxelMap& map, const Eigen::Vector3d& q, double max_distance,
+                                int neighbours, double max_flatness);
+
+}  // namespace rigcal::lidar

@@ -1,0 +1,293 @@
+// The LiDAR odometry (calib/lidar/): on the simulator's street scans (a car at 5 m/s, an OS0-128
+// at 10 Hz, raw motion-distorted sweeps with per-point times), against the simulator's truth:
+// per-step and end-point errors, what the deskew buys, whether the step covariances describe
+// the errors; the scan reader, the covariance file, and the command's errors.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <random>
+
+#include "cli_run.h"
+#include "fixtures.h"
+#include "rigcal/core/error.h"
+#include "rigcal/io/image_sets.h"
+#include "rigcal/io/odometry_io.h"
+#include "rigcal/io/point_cloud_io.h"
+#include "rigcal/io/session_io.h"
+#include "rigcal/io/trajectory_io.h"
+#include "rigcal/lidar/preprocess.h"
+#include "rigcal/lidar/step.h"
+#include "rigcal/rig/rig_yaml.h"
+#include "rigcal/sim/lidar.h"
+#include "rigcal/sim/session.h"
+
+namespace rigcal::lidar {
+namespace {
+
+namespace fs = std::filesystem;
+
+// One simulated drive shared by the tests of this file (ray casting is the slow part).
+class OdometryOnADrive : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new fs::path(fs::temp_directory_path() / fmt::format("rigcal_odometry_{}", ::getpid()));
+    fs::remove_all(*dir_);
+    sim::SimConfig config;
+    config.scans = 15;
+    const rig::Rig rig = rig::read_rig_file(RIGCAL_SOURCE_DIR "/data/sample_rig.yaml");
+    nlohmann::json truth;
+    io::write_scans(*dir_, sim::simulate_scans(rig, config), truth);
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*dir_);
+    delete dir_;
+  }
+  static fs::path scans() { return *dir_ / "scans" / "ouster_points"; }
+  static Trajectory truth() {
+    return io::read_trajectory(*dir_ / "scans" / "truth_lidar.tum").trajectory;
+  }
+  static fs::path* dir_;
+};
+fs::path* OdometryOnADrive::dir_ = nullptr;
+
+struct Errors {
+  double step_translation_mean_m = 0, step_translation_max_m = 0, step_rotation_max_deg = 0;
+  double end_translation_m = 0, length_m = 0;
+};
+
+// Relative motions of `estimate` against `truth`, pose by pose.
+Errors errors(const Trajectory& estimate, const Trajectory& truth) {
+  Errors e;
+  EXPECT_EQ(estimate.size(), truth.size());
+  for (size_t k = 1; k < std::min(estimate.size(), truth.size()); ++k) {
+    const SE3 est = estimate.T_world_body[k - 1].inverse() * estimate.T_world_body[k];
+    const SE3 tru = truth.T_world_body[k - 1].inverse() * truth.T_world_body[k];
+    const SE3 d = tru.inverse() * est;
+    e.step_translation_mean_m += d.t.norm() / double(estimate.size() - 1);
+    e.step_translation_max_m = std::max(e.step_translation_max_m, d.t.norm());
+    e.step_rotation_max_deg = std::max(e.step_rotation_max_deg, rotation_angle(d.R) * 180 / M_PI);
+    e.length_m += tru.t.norm();
+  }
+  const SE3 end_est = estimate.T_world_body.front().inverse() * estimate.T_world_body.back();
+  const SE3 end_tru = truth.T_world_body.front().inverse() * truth.T_world_body.back();
+  e.end_translation_m = (end_tru.inverse() * end_est).t.norm();
+  return e;
+}
+
+void print(const char* what, const Errors& e) {
+  std::printf(
+      "[ figures ] %s: per step %.4f m mean, %.4f m max, %.4f deg max; end %.4f m over %.2f m "
+      "(%.2f %%)\n",
+      what, e.step_translation_mean_m, e.step_translation_max_m, e.step_rotation_max_deg,
+      e.end_translation_m, e.length_m, 100 * e.end_translation_m / e.length_m);
+}
+
+// On a straight drive at constant speed every sweep is distorted alike, and the relative motions
+// come out nearly as well without the deskew (printed); the deskew's own test is the next one.
+TEST_F(OdometryOnADrive, FollowsTheSimulatedDrive) {
+  const OdometryRun run = run_odometry(scans(), os0_128_handheld());
+  const Errors deskewed = errors(run.T_odom_lidar, truth());
+  print("deskewed", deskewed);
+  OdometryConfig raw = os0_128_handheld();
+  raw.deskew = false;
+  const Errors as_measured = errors(run_odometry(scans(), raw).T_odom_lidar, truth());
+  print("not deskewed", as_measured);
+  EXPECT_LT(deskewed.step_translation_mean_m, 0.02);
+  EXPECT_LT(deskewed.end_translation_m, 0.01 * deskewed.length_m);
+  EXPECT_LT(as_measured.step_translation_mean_m, 0.02);
+  for (size_t k = 1; k < run.steps.size(); ++k) {
+    EXPECT_TRUE(run.steps[k].deskewed) << k;
+    EXPECT_TRUE(run.steps[k].converged) << k;
+    EXPECT_FALSE(run.steps[k].degeneracy.degenerate) << k;
+  }
+}
+
+// A sensor turning at 1 rad/s and moving at 1 m/s in a room (6 x 4 m half sizes, floor at
+// -1.5 m, ceiling at 2.5 m): a sweep turns 5.7 deg while it is measured.
+struct SpinningInARoom {
+  sim::Scene scene;
+  static constexpr double kHalfX = 6, kHalfY = 4, kFloor = -1.5, kCeiling = 2.5;
+  SpinningInARoom() {
+    sim::add_room(scene, kHalfX, kHalfY, kFloor, kCeiling);
+    SE3 T_world_box;
+    T_world_box.t = Eigen::Vector3d(3.0, 2.0, -1.0);
+    sim::add_box(scene, T_world_box, Eigen::Vector3d(0.5, 0.4, 0.5), 0.5);
+  }
+  static SE3 T_world_lidar(double t) {
+    SE3 T;
+    T.R = Eigen::AngleAxisd(1.0 * t, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    T.t = Eigen::Vector3d(-2.0 + 1.0 * t, 0.3 * t, 0.0);
+    return T;
+  }
+  Scan sweep(double t0, std::mt19937_64& rng) const {
+    Scan scan;
+    scan.stamp = Time::from_seconds(t0);
+    for (const sim::LidarPoint& p : sim::sweep(scene, sim::os0_128(), T_world_lidar, t0, rng))
+      scan.points.push_back({.p = p.p, .t_ns = p.t_ns});
+    return scan;
+  }
+  // Distance to the nearest wall, floor or ceiling (the box's points are left out).
+  static double room_distance(const Eigen::Vector3d& q) {
+    return std::min({std::abs(std::abs(q.x()) - kHalfX), std::abs(std::abs(q.y()) - kHalfY),
+                     std::abs(q.z() - kFloor), std::abs(q.z() - kCeiling)});
+  }
+};
+
+double percentile(std::vector<double> v, double fraction) {
+  std::nth_element(v.begin(), v.begin() + size_t(fraction * (v.size() - 1)), v.end());
+  return v[size_t(fraction * (v.size() - 1))];
+}
+
+// One sweep of the spinning sensor put in the room at its pose at the stamp: deskewed with the
+// motion over the sweep, its points lie on the walls within the range noise (1 cm); as measured,
+// the turn moves the far walls by decimetres.
+TEST(Deskew, ASpinningSweepLiesOnTheWallsOfTheRoom) {
+  const SpinningInARoom room;
+  std::mt19937_64 rng(7);
+  const Scan scan = room.sweep(0.0, rng);
+  const SE3 T_world_0 = SpinningInARoom::T_world_lidar(0.0);
+  const SE3 T_0_next = T_world_0.inverse() * SpinningInARoom::T_world_lidar(0.1);
+  auto distances = [&](const SE3& motion) {
+    std::vector<double> d;
+    for (const Eigen::Vector3d& p : deskewed_points(scan, motion, 0.1, 0.5, 50.0)) {
+      const Eigen::Vector3d q = T_world_0 * p;
+      if ((q - Eigen::Vector3d(3.0, 2.0, -1.0)).cwiseAbs().maxCoeff() > 0.8)  // not the box
+        d.push_back(SpinningInARoom::room_distance(q));
+    }
+    return d;
+  };
+  const std::vector<double> deskewed = distances(T_0_next), raw = distances(SE3::identity());
+  std::printf(
+      "[ figures ] distance of a spinning sweep's points to the room: median / 95th percentile "
+      "%.4f / %.4f m deskewed, %.4f / %.4f m as measured\n",
+      percentile(deskewed, 0.5), percentile(deskewed, 0.95), percentile(raw, 0.5),
+      percentile(raw, 0.95));
+  EXPECT_LT(percentile(deskewed, 0.5), 0.01);
+  EXPECT_LT(percentile(deskewed, 0.95), 0.025);
+  EXPECT_GT(percentile(raw, 0.95), 0.1);
+}
+
+// The odometry of the spinning sensor: with the deskew the steps are right to millimetres and
+// tenths of a degree; registered as measured, each sweep's turn is absorbed as an error.
+TEST(Deskew, TheOdometryOfASpinningSensorNeedsIt) {
+  const SpinningInARoom room;
+  std::mt19937_64 rng(11);
+  std::vector<Scan> scans;
+  Trajectory truth;
+  for (int k = 0; k < 12; ++k) {
+    scans.push_back(room.sweep(0.1 * k, rng));
+    truth.stamps.push_back(scans.back().stamp);
+    truth.T_world_body.push_back(SpinningInARoom::T_world_lidar(0.1 * k));
+  }
+  auto run = [&](bool deskew) {
+    OdometryConfig c = os0_128_handheld();
+    c.deskew = deskew;
+    Odometry o = start_odometry(c);
+    for (const Scan& s : scans) register_scan(o, s);
+    return errors(o.T_odom_lidar, truth);
+  };
+  const Errors deskewed = run(true), raw = run(false);
+  print("spinning, deskewed", deskewed);
+  print("spinning, not deskewed", raw);
+  EXPECT_LT(deskewed.step_translation_max_m, 0.01);
+  EXPECT_LT(deskewed.step_rotation_max_deg, 0.2);
+  EXPECT_GT(raw.step_translation_mean_m, 3 * deskewed.step_translation_mean_m);
+}
+
+// The step covariances against the steps' errors: the normalized squared error e^T C^-1 e has
+// mean 6 for a covariance that describes the errors.
+TEST_F(OdometryOnADrive, StepCovariancesAgainstTheErrors) {
+  const OdometryRun run = run_odometry(scans(), os0_128_handheld());
+  const Trajectory t = truth();
+  double nees = 0, sigma_t = 0, error_t = 0;
+  size_t n = 0;
+  for (size_t k = 2; k < run.steps.size(); ++k) {  // the second scan has no prediction
+    const SE3 est =
+        run.T_odom_lidar.T_world_body[k - 1].inverse() * run.T_odom_lidar.T_world_body[k];
+    const SE3 tru = t.T_world_body[k - 1].inverse() * t.T_world_body[k];
+    // est = perturbed(tru, e): the error in the previous frame's tangent.
+    Vector6d e;
+    e.head<3>() = rotation_vector(est.R * tru.R.transpose());
+    e.tail<3>() = est.t - tru.t;
+    const Matrix6d& C = run.steps[k].covariance_prev_cur;
+    nees += e.dot(C.ldlt().solve(e));
+    sigma_t += std::sqrt(C.bottomRightCorner<3, 3>().trace());
+    error_t += e.tail<3>().norm();
+    ++n;
+  }
+  nees /= n;
+  std::printf(
+      "[ figures ] mean NEES %.1f (6 if the covariance describes the errors); mean "
+      "translation sigma %.4f m, mean translation error %.4f m\n",
+      nees, sigma_t / n, error_t / n);
+  // Open: the covariance is optimistic (the residuals of neighbouring points are not
+  // independent, and the map's own error is not in it); this bounds it where it stands.
+  EXPECT_LT(nees, 1000.0);
+}
+
+TEST(OdometryIo, CovariancesReadBackAsWritten) {
+  io::StepCovariance s{Time::from_ns(1'000'000'000), Time::from_ns(1'100'000'001), {}};
+  Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Random();
+  s.covariance = A * A.transpose() * 1e-5;
+  const fs::path file = fs::temp_directory_path() / fmt::format("rigcal_cov_{}.txt", ::getpid());
+  std::ofstream(file) << io::step_covariances_to_text({s, s});
+  const std::vector<io::StepCovariance> back = io::read_step_covariances(file);
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_EQ(back[1].prev, s.prev);
+  EXPECT_EQ(back[1].cur, s.cur);
+  EXPECT_EQ(back[1].covariance, s.covariance);
+  std::ofstream(file) << "1.0 2.0 3.0\n";
+  EXPECT_NE(
+      testing::error_message_of([&] { io::read_step_covariances(file); }).find(":1: 3 fields"),
+      std::string::npos);
+  fs::remove(file);
+}
+
+TEST_F(OdometryOnADrive, ScansReadWithTheirTimesOrSayTheyHaveNone) {
+  const io::StampedFolder f = io::read_stamped_folder(scans(), ".bin");
+  const Scan with = io::read_scan(f.files[3]);
+  EXPECT_TRUE(with.point_times);
+  int64_t last_ns = 0;
+  for (const ScanPoint& p : with.points) last_ns = std::max(last_ns, p.t_ns);
+  EXPECT_GT(last_ns, 90'000'000);  // the sweep lasts 100 ms
+  EXPECT_LE(last_ns, 100'000'000);
+  // The same points without the simulator's sidecar: KITTI points, no times.
+  const fs::path kitti = *dir_ / "kitti" / "data" / "0000000003.bin";
+  fs::create_directories(kitti.parent_path());
+  fs::copy_file(f.files[3], kitti);
+  const Scan without = io::read_scan(kitti);
+  EXPECT_FALSE(without.point_times);
+  ASSERT_EQ(without.points.size(), with.points.size());
+  EXPECT_EQ(without.points[100].p, with.points[100].p);
+}
+
+TEST_F(OdometryOnADrive, TheCommandWritesAllOrNothingAndNamesBadInput) {
+  const fs::path out = *dir_ / "out";
+  fs::create_directories(out);
+  const testing::CliRun ok = testing::rigcal_cli(
+      fmt::format("odometry {} --out {} --report {}", (*dir_ / "scans").string(),
+                  (out / "odom.tum").string(), (out / "report").string()),
+      out);
+  ASSERT_EQ(ok.status, 0) << ok.err;
+  EXPECT_NE(ok.out.find("15 registered"), std::string::npos) << ok.out;
+  EXPECT_EQ(io::read_trajectory(out / "odom.tum").trajectory.size(), 15u);
+  EXPECT_EQ(io::read_step_covariances(out / "odom_covariances.txt").size(), 14u);
+  const nlohmann::json report =
+      nlohmann::json::parse(testing::slurp(out / "report" / "odometry.json"));
+  EXPECT_EQ(report["steps"].size(), 14u);
+  EXPECT_EQ(report["summary"]["scans"], 15);
+
+  const testing::CliRun none = testing::rigcal_cli(
+      fmt::format("odometry {} --out {}", (out / "report").string(), (out / "x.tum").string()),
+      out);
+  EXPECT_EQ(none.status, 2);
+  EXPECT_NE(none.err.find("no scans"), std::string::npos) << none.err;
+  EXPECT_FALSE(fs::exists(out / "x.tum"));
+}
+
+}  // namespace
+}  // namespace rigcal::lidar
