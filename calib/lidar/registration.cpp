@@ -5,6 +5,7 @@
 
 #include <Eigen/Cholesky>
 #include <cmath>
+#include <unordered_map>
 
 namespace rigcal::lidar {
 namespace {
@@ -16,16 +17,22 @@ struct Normal {  // the normal equations of one pass
   Vector6d JtWr = Vector6d::Zero();
   double sum_w = 0, sum_wr2 = 0, sum_r2 = 0;
   size_t n = 0;
+  // Where asked: the gradient sum w r J of the residuals in each cluster (a cube of the space).
+  std::unordered_map<Eigen::Vector3i, Vector6d, VoxelHash> clusters;
   Normal& operator+=(const Normal& o) {
     JtWJ += o.JtWJ, JtWr += o.JtWr, sum_w += o.sum_w, sum_wr2 += o.sum_wr2, sum_r2 += o.sum_r2;
     n += o.n;
+    for (const auto& [key, g] : o.clusters) {
+      auto [it, inserted] = clusters.try_emplace(key, g);
+      if (!inserted) it->second += g;
+    }
     return *this;
   }
 };
 
 Normal linearize(const std::vector<Eigen::Vector3d>& points_lidar, const VoxelMap& map,
                  const SE3& T_odom_lidar, double max_correspondence_m, double kernel_m,
-                 const RegistrationConfig& config) {
+                 const RegistrationConfig& config, double cluster_size_m = 0) {
   const double c2 = kernel_m * kernel_m;
   return tbb::parallel_reduce(
       tbb::blocked_range<size_t>(0, points_lidar.size(), 256), Normal{},
@@ -46,6 +53,10 @@ Normal linearize(const std::vector<Eigen::Vector3d>& points_lidar, const VoxelMa
           acc.JtWr.noalias() += w * r * J;
           acc.sum_w += w, acc.sum_wr2 += w * r * r, acc.sum_r2 += r * r;
           ++acc.n;
+          if (cluster_size_m > 0) {
+            auto [it, inserted] = acc.clusters.try_emplace(voxel_of(q, cluster_size_m), w * r * J);
+            if (!inserted) it->second += w * r * J;
+          }
         }
         return acc;
       },
@@ -74,13 +85,25 @@ Registration register_points(const std::vector<Eigen::Vector3d>& points_lidar, c
     }
   }
   // The information and noise at the solution.
-  normal = linearize(points_lidar, map, out.T_odom_lidar, max_correspondence_m, kernel_m, config);
+  normal = linearize(points_lidar, map, out.T_odom_lidar, max_correspondence_m, kernel_m, config,
+                     config.cluster_size_m);
   out.correspondences = normal.n;
   if (normal.n < 6) return out;
   out.information = normal.JtWJ;
   out.noise_sigma_m = std::sqrt(normal.sum_wr2 / std::max(normal.sum_w - 6.0, 1.0));
   out.residual_rms_m = std::sqrt(normal.sum_r2 / static_cast<double>(normal.n));
-  out.covariance = out.noise_sigma_m * out.noise_sigma_m * normal.JtWJ.inverse();
+  const Matrix6d H_inv = normal.JtWJ.inverse();
+  out.covariance_independent = out.noise_sigma_m * out.noise_sigma_m * H_inv;
+  out.covariance = out.covariance_independent;
+  const double G = static_cast<double>(normal.clusters.size());
+  if (config.cluster_size_m > 0 && G > 12) {
+    // Cluster-robust (sandwich) form: residuals of one cluster may share an error (a map plane
+    // off by a millimetre moves all of them), clusters are taken as independent.
+    Matrix6d B = Matrix6d::Zero();
+    for (const auto& [key, g] : normal.clusters) B.noalias() += g * g.transpose();
+    out.covariance = G / (G - 1.0) * H_inv * B * H_inv;
+    out.clusters = normal.clusters.size();
+  }
   return out;
 }
 

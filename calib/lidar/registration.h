@@ -19,6 +19,9 @@ struct RegistrationConfig {
   double convergence = 1e-4;  // stop when the step (rad and m together) is below this
   int plane_neighbours = 8;   // map points a plane is fitted to
   double max_flatness = 0.1;  // smallest over middle scatter eigenvalue of a plane's points
+  // The covariance's clusters: cubes of this size (m) whose residuals may share an error; 0:
+  // every residual independent.
+  double cluster_size_m = 2.0;
 };
 
 struct Registration {
@@ -28,8 +31,12 @@ struct Registration {
   Matrix6d information = Matrix6d::Zero();
   // sqrt(sum w r^2 / (sum w - 6)): the residuals' noise level, m.
   double noise_sigma_m = 0;
-  // covariance of T_odom_lidar in that tangent: noise_sigma^2 * information^-1 (rad, m).
+  // covariance of T_odom_lidar in that tangent (rad, m): cluster-robust, H^-1 B H^-1 with B the
+  // sum over clusters of their gradients' outer products (G / (G - 1) corrected), where there are
+  // more than 12 clusters; else, and in covariance_independent, noise_sigma^2 * H^-1.
   Matrix6d covariance = Matrix6d::Zero();
+  Matrix6d covariance_independent = Matrix6d::Zero();
+  size_t clusters = 0;
   size_t points = 0, correspondences = 0;
   double residual_rms_m = 0;  // over the correspondences, unweighted
   int iterations = 0;
