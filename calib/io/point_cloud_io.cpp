@@ -212,6 +212,22 @@ Scan read_bin(const std::filesystem::path& path, bool sidecar_times) {
                               path.string()));
     }
   }
+  // Not LiDAR points: coordinates of 100 km and more, or all three below 1e-20 m (a record's
+  // integer fields read as floats: full records without their .metadata.json, or random bytes).
+  size_t implausible = 0;
+  for (size_t k = 0; k + 16 <= data.size(); k += 16) {
+    float v[3];
+    std::memcpy(v, data.data() + k, 12);
+    const float m = std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])});
+    implausible += std::isfinite(m) && (m >= 1e5f || (m > 0 && m < 1e-20f));
+  }
+  if (implausible * 100 > data.size() / 16) {
+    throw Error(fmt::format(
+        "{}: {} of {} points lie 100 km away or within 1e-20 m of the sensor: not KITTI points "
+        "(float32 x y z intensity){}",
+        path.string(), implausible, data.size() / 16,
+        fields.empty() ? "; full records need their topic's .metadata.json beside data/" : ""));
+  }
   scan.point_times = !sidecar_data.empty();
   scan.points.reserve(data.size() / 16);
   for (size_t k = 0; k < data.size(); k += 16) {

@@ -56,6 +56,7 @@ OdometryRun run_odometry(const fs::path& scans, const OdometryConfig& config,
   size_t without_times = 0;
   for (size_t k = 0; k < folder.files.size(); ++k) {
     Scan scan = io::read_scan(folder.files[k]);
+    if (scan.points.empty()) throw Error(fmt::format("{}: no points", folder.files[k]));
     scan.stamp = folder.stamps[k];
     without_times += !scan.point_times;
     run.steps.push_back(register_scan(odometry, scan));

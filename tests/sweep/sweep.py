@@ -559,6 +559,11 @@ def scenarios():
               "scan": ("lc3/dev/ouster_points/data/0000000001.bin", "devbin", True),
               "timestamps": ("lc3/dev/ouster_points/timestamps.txt", T, True),
               "cam-timestamps": ("lc3/dev/camera_right/timestamps.txt", T, True)})
+    sc("odometry-devkit", ["odometry", "lc3/dev", "--out", "out/odom.tum", "--report", "out/rep"],
+       clone=["lc3/dev"], outs=["out/odom.tum", "out/odom_covariances.txt"], reports=["out/rep"], cost=2.0,
+       slots={"metadata": ("lc3/dev/ouster_points/.metadata.json", "json", True),
+              "scan": ("lc3/dev/ouster_points/data/0000000001.bin", "devbin", True),
+              "timestamps": ("lc3/dev/ouster_points/timestamps.txt", T, True)})
     sc("time-offset", ["time-offset", "--session", "imus", "--rig", "rig.yaml", "--sensor", "imu",
                        "--reference-sensor", "os_imu", "--out", "out/to.yaml", "--report", "out/rep"],
        clone=["imus"], copy=[("sim/truth.yaml", "rig.yaml")], outs=["out/to.yaml"], prev=["out/to.yaml"],

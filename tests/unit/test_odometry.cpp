@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -280,6 +281,22 @@ TEST_F(OdometryOnADrive, ScansReadWithTheirTimesOrSayTheyHaveNone) {
   EXPECT_FALSE(without.point_times);
   ASSERT_EQ(without.points.size(), with.points.size());
   EXPECT_EQ(without.points[100].p, with.points[100].p);
+  // Integers read as floats (full records without their metadata) and huge numbers are not
+  // points: refused, the file named.
+  std::string ints(16 * 1000, '\0'), huge(16 * 1000, '\0');
+  for (uint32_t k = 0; k < 4000; ++k) {
+    const uint32_t v = k % 700 + 1;
+    const float h = 3e7f + float(k);
+    std::memcpy(ints.data() + 4 * k, &v, 4);
+    std::memcpy(huge.data() + 4 * k, &h, 4);
+  }
+  for (const std::string& bytes : {ints, huge}) {
+    std::ofstream(kitti, std::ios::binary) << bytes;
+    const std::string e = testing::error_message_of([&] { io::read_scan(kitti); });
+    EXPECT_NE(e.find(kitti.string() + ": 1000 of 1000 points lie 100 km away or within 1e-20 m"),
+              std::string::npos)
+        << e;
+  }
 }
 
 TEST_F(OdometryOnADrive, TheCommandWritesAllOrNothingAndNamesBadInput) {

@@ -23,6 +23,7 @@
 #include "rigcal/io/ouster_metadata.h"
 #include "rigcal/io/ouster_packet.h"
 #include "rigcal/io/ouster_pcap.h"
+#include "rigcal/lidar/odometry.h"
 
 namespace rigcal {
 namespace {
@@ -823,6 +824,40 @@ TEST(OusterGeometry, ThreeFramesAgreeWithTheirPublishedPoses) {
   // of the sensor frame, which the points are in.
   EXPECT_GT(d02_identity, 1.5 * d02);
   EXPECT_GT(d02_lidar, 1.5 * d02);
+}
+
+// rigcal's odometry on the same three frames (the car preset): its poses put frames 0 and 2 on
+// each other as well as the published ones do, and lie within centimetres of them.
+TEST(OusterGeometry, TheOdometryOfTheThreeFramesAgreesWithThePublishedPoses) {
+  RIGCAL_REQUIRE_FIXTURE(pcap, "lidar/ouster_os1_128/OS-1-128_v2.3.0_1024x10_lb_n3.pcap");
+  RIGCAL_REQUIRE_FIXTURE(json, "lidar/ouster_os1_128/OS-1-128_v2.3.0_1024x10.json");
+  RIGCAL_REQUIRE_FIXTURE(poses_path,
+                         "lidar/ouster_os1_128/OS-1-128_v2.3.0_1024x10_lb_n3_poses_kitti.txt");
+  const Os1128 r = read_os1_128(pcap, json);
+  ASSERT_EQ(r.scans.size(), 3u);
+  const std::vector<SE3> T_world_sensor = read_kitti_poses(poses_path);
+  lidar::Odometry odometry = lidar::start_odometry(lidar::os1_64_car());
+  for (const Scan& s : r.scans) lidar::register_scan(odometry, s);
+  const std::vector<SE3>& T_odom_sensor = odometry.T_odom_lidar.T_world_body;
+  size_t used = 0, used_published = 0;
+  const double d02 =
+      median_point_to_plane(r.scans[0], T_odom_sensor[0], r.scans[2], T_odom_sensor[2], 5, &used);
+  const double d02_published = median_point_to_plane(r.scans[0], T_world_sensor[0], r.scans[2],
+                                                     T_world_sensor[2], 5, &used_published);
+  double max_translation_m = 0, max_rotation_deg = 0;
+  for (size_t k = 1; k < 3; ++k) {
+    const SE3 d = (T_world_sensor[0].inverse() * T_world_sensor[k]).inverse() * T_odom_sensor[k];
+    max_translation_m = std::max(max_translation_m, d.t.norm());
+    max_rotation_deg = std::max(max_rotation_deg, rotation_angle(d.R) * 180 / M_PI);
+  }
+  std::printf(
+      "[ figures ] OS-1-128 frames 0, 2 (points as measured): median point-to-plane %.4f m with "
+      "rigcal's odometry, %.4f m with the published poses; odometry against them: %.4f m, "
+      "%.3f deg at most\n",
+      d02, d02_published, max_translation_m, max_rotation_deg);
+  EXPECT_LT(d02, 0.03);
+  EXPECT_LT(max_translation_m, 0.05);
+  EXPECT_LT(max_rotation_deg, 0.5);
 }
 
 TEST(OusterGeometry, PointTimesLieInTheSweepAndIncreaseWithColumn) {
