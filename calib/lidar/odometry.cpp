@@ -89,13 +89,17 @@ Step register_scan(Odometry& o, const Scan& scan) {
   // the prediction (none for the second scan), then the estimate. The first scan is deskewed
   // once the second has been registered (below).
   const bool deskew = c.deskew && scan.point_times && n >= 1;
-  auto points_at = [&](const SE3& T_cur_next) {
-    return deskewed_points(scan, deskew ? T_cur_next : SE3::identity(), period_s, c.min_range_m,
-                           c.max_range_m);
+  // Sampled before the deskew (which moves points by centimetres, not voxels): the map's level
+  // and the registration's, each deskewed again when the motion is better known.
+  const std::vector<ScanPoint> frame_raw =
+      voxel_sample(scan.points, 0.5 * c.voxel_size_m, c.min_range_m, c.max_range_m);
+  const std::vector<ScanPoint> source_raw =
+      voxel_sample(frame_raw, 1.5 * c.voxel_size_m, 0.0, INFINITY);
+  auto deskewed = [&](const std::vector<ScanPoint>& points, const SE3& T_cur_next) {
+    return lidar::deskew(points, T_cur_next, period_s, deskew);
   };
-  std::vector<Eigen::Vector3d> frame =
-      voxel_downsample(points_at(T_prev_cur_predicted), 0.5 * c.voxel_size_m);
-  std::vector<Eigen::Vector3d> source = voxel_downsample(frame, 1.5 * c.voxel_size_m);
+  std::vector<Eigen::Vector3d> frame = deskewed(frame_raw, T_prev_cur_predicted);
+  std::vector<Eigen::Vector3d> source = deskewed(source_raw, T_prev_cur_predicted);
   step.points_used = source.size();
   step.deskewed = deskew;
   SE3 T_odom_cur = T_odom_predicted;
@@ -103,8 +107,8 @@ Step register_scan(Odometry& o, const Scan& scan) {
     const double sigma = sigma_m(o.threshold);
     step.threshold_m = 3.0 * sigma;
     auto registered = [&](const SE3& T_guess, const SE3& T_prev_cur_motion) {
-      frame = voxel_downsample(points_at(T_prev_cur_motion), 0.5 * c.voxel_size_m);
-      source = voxel_downsample(frame, 1.5 * c.voxel_size_m);
+      frame = deskewed(frame_raw, T_prev_cur_motion);
+      source = deskewed(source_raw, T_prev_cur_motion);
       return register_points(source, o.map, T_guess, 3.0 * sigma, sigma / 3.0, c.registration);
     };
     Registration r =
@@ -115,9 +119,7 @@ Step register_scan(Odometry& o, const Scan& scan) {
     // it, and the second registered again (twice: the motion improves with the map).
     for (int pass = 0; deskew && n == 1 && o.first_scan.point_times && pass < 2; ++pass) {
       o.map.voxels.clear();
-      add_points(o.map, voxel_downsample(deskewed_points(o.first_scan, r.T_odom_lidar, period_s,
-                                                         c.min_range_m, c.max_range_m),
-                                         0.5 * c.voxel_size_m));
+      add_points(o.map, lidar::deskew(o.first_scan.points, r.T_odom_lidar, period_s, true));
       r = registered(r.T_odom_lidar, r.T_odom_lidar);
     }
     if (n == 1) o.first_scan = Scan{};
@@ -135,7 +137,9 @@ Step register_scan(Odometry& o, const Scan& scan) {
     step.iterations = r.iterations;
     step.converged = r.converged;
   } else {
-    o.first_scan = scan;
+    o.first_scan.stamp = scan.stamp;
+    o.first_scan.point_times = scan.point_times;
+    o.first_scan.points = frame_raw;
   }
   step.T_odom_lidar = T_odom_cur;
   std::vector<Eigen::Vector3d> frame_odom;

@@ -64,7 +64,7 @@ struct Odometry {
   VoxelMap map;
   AdaptiveThreshold threshold;
   Trajectory T_odom_lidar;  // one pose a registered scan
-  Scan first_scan;          // kept until the second scan gives the motion to deskew it
+  Scan first_scan;  // its map sample, kept until the second scan gives the motion to deskew it
 };
 
 Odometry start_odometry(const OdometryConfig& config);

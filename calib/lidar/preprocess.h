@@ -15,6 +15,16 @@ namespace rigcal::lidar {
 // motion itself; any real fraction): rotation exp(f log R), translation f t.
 SE3 motion_fraction(const SE3& T_start_end, double fraction);
 
+// The first point of every voxel of the given size among those with a range in
+// [min_range, max_range], in input order, with its time.
+std::vector<ScanPoint> voxel_sample(const std::vector<ScanPoint>& points, double voxel_size,
+                                    double min_range, double max_range);
+
+// The points moved to the sensor's pose at the scan's stamp (see deskewed_points); as they are
+// where `point_times` is false.
+std::vector<Eigen::Vector3d> deskew(const std::vector<ScanPoint>& points, const SE3& T_start_next,
+                                    double period_s, bool point_times);
+
 // The scan's points in the sensor frame at the scan's stamp, those with a range in
 // [min_range, max_range] only. `T_start_next` is the sensor's motion from this scan's stamp over
 // `period_s` (the next stamp's pose in this one's frame); a point measured t after the stamp is

@@ -72,13 +72,19 @@ Registration register_points(const std::vector<Eigen::Vector3d>& points_lidar, c
   out.T_odom_lidar = T_odom_lidar_guess;
   out.points = points_lidar.size();
   Normal normal;
+  double last_step = INFINITY;
   for (out.iterations = 0; out.iterations < config.max_iterations; ++out.iterations) {
     normal = linearize(points_lidar, map, out.T_odom_lidar, max_correspondence_m, kernel_m, config);
     if (normal.n < 6) return out;
     const Vector6d d = normal.JtWJ.ldlt().solve(-normal.JtWr);
     if (!d.allFinite()) return out;
     out.T_odom_lidar = perturbed(out.T_odom_lidar, d);
-    if (d.norm() < config.convergence) {
+    // Converged: a step below the tolerance, or below ten times it without halving (the
+    // correspondences switching between two neighbour sets: a cycle of that size).
+    const double step = d.norm();
+    const bool cycling = step < 10 * config.convergence && step > 0.5 * last_step;
+    last_step = step;
+    if (step < config.convergence || cycling) {
       out.converged = true;
       ++out.iterations;
       break;

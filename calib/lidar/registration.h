@@ -16,7 +16,9 @@ using Matrix6d = Eigen::Matrix<double, 6, 6>;
 
 struct RegistrationConfig {
   int max_iterations = 50;
-  double convergence = 1e-4;  // stop when the step (rad and m together) is below this
+  // Stop when the step (rad and m together) is below this, or below ten times it without
+  // halving from the one before (correspondences switching between two sets).
+  double convergence = 1e-4;
   int plane_neighbours = 8;   // map points a plane is fitted to
   double max_flatness = 0.1;  // smallest over middle scatter eigenvalue of a plane's points
   // The covariance's clusters: cubes of this size (m) whose residuals may share an error; 0:

@@ -39,23 +39,27 @@ std::optional<Plane> plane_near(const VoxelMap& map, const Eigen::Vector3d& q, d
   std::array<std::pair<double, const Eigen::Vector3d*>, kMaxNeighbours> nearest;
   int k = 0;
   const double max_squared = max_distance * max_distance;
-  const Eigen::Vector3i centre = voxel_of(q, map.voxel_size);
-  for (int dx = -1; dx <= 1; ++dx) {
-    for (int dy = -1; dy <= 1; ++dy) {
-      for (int dz = -1; dz <= 1; ++dz) {
-        const auto it = map.voxels.find(centre + Eigen::Vector3i(dx, dy, dz));
-        if (it == map.voxels.end()) continue;
-        for (const Eigen::Vector3d& p : it->second) {
-          const double d2 = (p - q).squaredNorm();
-          if (d2 > max_squared || (k == k_wanted && d2 >= nearest[k - 1].first)) continue;
-          int at = k < k_wanted ? k++ : k - 1;
-          while (at > 0 && nearest[at - 1].first > d2) {
-            nearest[at] = nearest[at - 1];
-            --at;
-          }
-          nearest[at] = {d2, &p};
-        }
+  // The 2 x 2 x 2 voxels around the voxel corner nearest q: every point within half a voxel of
+  // q in each axis is among them.
+  const Eigen::Vector3d scaled = q / map.voxel_size;
+  const Eigen::Vector3i home = scaled.array().floor().cast<int>();
+  Eigen::Vector3i step;
+  for (int a = 0; a < 3; ++a) step(a) = scaled(a) - home(a) < 0.5 ? -1 : 1;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3i v(home.x() + (corner & 1 ? step.x() : 0),
+                            home.y() + (corner & 2 ? step.y() : 0),
+                            home.z() + (corner & 4 ? step.z() : 0));
+    const auto it = map.voxels.find(v);
+    if (it == map.voxels.end()) continue;
+    for (const Eigen::Vector3d& p : it->second) {
+      const double d2 = (p - q).squaredNorm();
+      if (d2 > max_squared || (k == k_wanted && d2 >= nearest[k - 1].first)) continue;
+      int at = k < k_wanted ? k++ : k - 1;
+      while (at > 0 && nearest[at - 1].first > d2) {
+        nearest[at] = nearest[at - 1];
+        --at;
       }
+      nearest[at] = {d2, &p};
     }
   }
   if (k < 5) return std::nullopt;

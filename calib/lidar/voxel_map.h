@@ -38,9 +38,9 @@ struct Plane {
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
   double flatness = 0;
 };
-// The plane through the `neighbours` map points nearest q within `max_distance` (searched in the
-// 27 voxels around q); none when fewer than 5 are found or they do not lie on a plane (flatness
-// over `max_flatness`).
+// The plane through the `neighbours` map points nearest q within `max_distance`, searched in the
+// 8 voxels around the voxel corner nearest q (all points within half a voxel of q); none when fewer
+// than 5 are found or they do not lie on a plane (flatness over `max_flatness`).
 std::optional<Plane> plane_near(const VoxelMap& map, const Eigen::Vector3d& q, double max_distance,
                                 int neighbours, double max_flatness);
 

@@ -241,10 +241,10 @@ TEST_F(OdometryOnADrive, StepCovariancesAgainstTheErrors) {
     }
   }
   // Open: the first steps' errors, a map of two or three sweeps, are several sigmas (the map's
-  // own error is not in the covariance); past them the clustered covariance is within a factor
-  // of about 1.5 in sigma.
-  EXPECT_LT(clustered_after[0], 20.0);
-  EXPECT_GT(clustered_after[0], 1.0);
+  // own error is not in the covariance); past them the clustered covariance describes the
+  // errors (4.7 measured): neither a factor 2 optimistic nor a factor 2 cautious in sigma.
+  EXPECT_LT(clustered_after[0], 24.0);
+  EXPECT_GT(clustered_after[0], 1.5);
 }
 
 TEST(OdometryIo, CovariancesReadBackAsWritten) {
