@@ -7,6 +7,10 @@
 
 namespace rigcal::lidar {
 
+namespace {
+constexpr double kMinSpread = 0.05;  // middle over largest scatter eigenvalue of a plane's points
+}  // namespace
+
 Eigen::Vector3i voxel_of(const Eigen::Vector3d& p, double voxel_size) {
   return (p / voxel_size).array().floor().cast<int>();
 }
@@ -78,6 +82,9 @@ std::optional<Plane> plane_near(const VoxelMap& map, const Eigen::Vector3d& q, d
   Plane plane;
   plane.flatness = std::max(lambda(0), 0.0) / lambda(1);
   if (plane.flatness > max_flatness) return std::nullopt;
+  // Points along a line (one scan ring on a far wall) fix no normal about the line: a normal
+  // from them would constrain a direction the surface does not.
+  if (lambda(1) < kMinSpread * lambda(2)) return std::nullopt;
   plane.normal = eigen.eigenvectors().col(0).normalized();
   plane.point = mean;
   return plane;

@@ -40,7 +40,9 @@ struct Plane {
 };
 // The plane through the `neighbours` map points nearest q within `max_distance`, searched in the
 // 8 voxels around the voxel corner nearest q (all points within half a voxel of q); none when fewer
-// than 5 are found or they do not lie on a plane (flatness over `max_flatness`).
+// than 5 are found, they do not lie on a plane (flatness over `max_flatness`) or they lie along a
+// line (the middle scatter eigenvalue under 0.05 of the largest: a normal about the line is not
+// determined).
 std::optional<Plane> plane_near(const VoxelMap& map, const Eigen::Vector3d& q, double max_distance,
                                 int neighbours, double max_flatness);
 
