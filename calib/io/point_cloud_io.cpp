@@ -6,9 +6,11 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <type_traits>
 
 #include "rigcal/core/error.h"
 #include "rigcal/core/text.h"
@@ -71,6 +73,14 @@ double field_value(const char* record, const Field& f) {
   }
 }
 
+// A non-negative integer of the metadata (a float, a negative or a string is refused: converting
+// one would overflow or guess).
+size_t whole_number(const nlohmann::json& v, const char* what) {
+  if (!v.is_number_unsigned() && !(v.is_number_integer() && v.get<int64_t>() >= 0))
+    throw Error(fmt::format("{} {} is not a non-negative integer", what, v.dump()));
+  return v.get<size_t>();
+}
+
 // vbr-devkit writes a topic's fields in <topic>/.metadata.json beside data/; with
 // --no-reduce-pcloud each point is the driver's whole record (point_step bytes), otherwise the
 // four float32 x, y, z, intensity. Empty when there is no such file.
@@ -88,8 +98,9 @@ std::vector<Field> vbr_fields(const std::filesystem::path& bin, size_t& point_st
   size_t extent = 0;
   try {
     for (const auto& f : j.at("fields")) {
-      Field x{f.at("name").get<std::string>(), f.at("offset").get<size_t>(),
-              f.at("datatype").get<int>(), f.value("count", size_t{1})};
+      Field x{f.at("name").get<std::string>(), whole_number(f.at("offset"), "offset"),
+              static_cast<int>(std::min<size_t>(whole_number(f.at("datatype"), "datatype"), 99)),
+              f.contains("count") ? whole_number(f.at("count"), "count") : size_t{1}};
       if (datatype_size(x.datatype) == 0)
         throw Error(fmt::format("field '{}': datatype {} unknown", x.name, x.datatype));
       if (x.offset > kMaxRecordBytes || x.count > kMaxRecordBytes)
@@ -106,15 +117,29 @@ std::vector<Field> vbr_fields(const std::filesystem::path& bin, size_t& point_st
   // The record's size: "point_step" where given, else the fields' extent padded to 16 bytes
   // (the Ouster driver's and PCL's aligned point types: 48 bytes for x..range).
   try {
-    point_step = j.contains("point_step") ? j["point_step"].get<size_t>() : (extent + 15) / 16 * 16;
+    point_step = j.contains("point_step") ? whole_number(j["point_step"], "point_step")
+                                          : (extent + 15) / 16 * 16;
   } catch (const nlohmann::json::exception& e) {
     throw Error(fmt::format("{}: point_step not read ({})", meta.string(), e.what()));
+  } catch (const Error& e) {
+    throw Error(fmt::format("{}: {}", meta.string(), e.what()));
   }
   if (point_step < extent || point_step > kMaxRecordBytes) {
     throw Error(fmt::format("{}: point_step {} does not hold the fields ({} bytes)", meta.string(),
                             point_step, extent));
   }
   return fields;
+}
+
+// v as a T, held to T's range (NaN: 0): a damaged record's values convert without overflow.
+template <typename T>
+T saturated(double v) {
+  if (!(v == v)) return T{0};
+  const double low = static_cast<double>(std::numeric_limits<T>::lowest());
+  const double high = static_cast<double>(std::numeric_limits<T>::max());
+  if (v <= low) return std::numeric_limits<T>::lowest();
+  if (v >= high) return std::numeric_limits<T>::max();
+  return static_cast<T>(std::is_integral_v<T> ? std::round(v) : v);
 }
 
 bool no_return(double x, double y, double z) {
@@ -179,15 +204,15 @@ Scan read_bin(const std::filesystem::path& path, bool sidecar_times) {
       const double x = field_value(r, *fx), y = field_value(r, *fy), z = field_value(r, *fz);
       if (no_return(x, y, z)) continue;
       ScanPoint p;
-      p.p = Eigen::Vector3d(x, y, z).cast<float>();
+      p.p = Eigen::Vector3f(saturated<float>(x), saturated<float>(y), saturated<float>(z));
       if (ft) {
         const double t = field_value(r, *ft);
-        p.t_ns = static_cast<int64_t>(ft->datatype >= 7 ? std::llround(t * 1e9) : t);
+        p.t_ns = saturated<int64_t>(ft->datatype >= 7 ? t * 1e9 : t);
       }
-      if (fi) p.intensity = static_cast<float>(field_value(r, *fi));
-      if (ring) p.ring = static_cast<uint16_t>(field_value(r, *ring));
-      if (fr) p.reflectivity = static_cast<uint16_t>(std::clamp(field_value(r, *fr), 0.0, 65535.0));
-      if (frange) p.range_mm = static_cast<uint32_t>(std::max(field_value(r, *frange), 0.0));
+      if (fi) p.intensity = saturated<float>(field_value(r, *fi));
+      if (ring) p.ring = saturated<uint16_t>(field_value(r, *ring));
+      if (fr) p.reflectivity = saturated<uint16_t>(field_value(r, *fr));
+      if (frange) p.range_mm = saturated<uint32_t>(field_value(r, *frange));
       scan.points.push_back(p);
     }
     return scan;

@@ -1,4 +1,4 @@
-// Point clouds (io::read_point_cloud, a path): RIGCAL_FUZZ_CLOUD is pcd or bin. For .bin, the
+// Point clouds (io::read_point_cloud and io::read_scan, a path): RIGCAL_FUZZ_CLOUD is pcd or bin. For .bin, the
 // part before a line "--bin--" is the topic's .metadata.json (vbr-devkit's full-field layout);
 // without it the file is read as KITTI points.
 #include "fuzz_common.h"
@@ -25,5 +25,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   fuzz::write_file(file, bytes);
   fuzz::expect_only_rigcal_errors([&] { io::read_point_cloud(file); });
+  fuzz::expect_only_rigcal_errors([&] { io::read_scan(file); });
   return 0;
 }
