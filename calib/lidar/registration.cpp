@@ -34,7 +34,9 @@ Normal linearize(const std::vector<Eigen::Vector3d>& points_lidar, const VoxelMa
                  const SE3& T_odom_lidar, double max_correspondence_m, double kernel_m,
                  const RegistrationConfig& config, double cluster_size_m = 0) {
   const double c2 = kernel_m * kernel_m;
-  return tbb::parallel_reduce(
+  // Deterministic: the same chunks joined in the same order every run, so that a run repeats
+  // to the last bit whatever the threads do.
+  return tbb::parallel_deterministic_reduce(
       tbb::blocked_range<size_t>(0, points_lidar.size(), 256), Normal{},
       [&](const tbb::blocked_range<size_t>& range, Normal acc) {
         for (size_t i = range.begin(); i != range.end(); ++i) {

@@ -7,6 +7,8 @@
 
 #include "rigcal/core/error.h"
 #include "rigcal/io/image_sets.h"
+#include "rigcal/io/ouster_metadata.h"
+#include "rigcal/io/ouster_pcap.h"
 #include "rigcal/io/point_cloud_io.h"
 #include "rigcal/io/session.h"
 
@@ -31,6 +33,7 @@ std::string scan_extension(const fs::path& folder) {
 }  // namespace
 
 fs::path scans_folder(const fs::path& given, const report::Progress& progress) {
+  if (fs::is_regular_file(given) && io::is_pcap_capture(given)) return given;  // read as it is
   if (fs::is_directory(given) && is_scan_topic(given) && !fs::exists(given / "ouster_points"))
     return given;
   if (is_scan_topic(given / "ouster_points")) return given / "ouster_points";
@@ -45,28 +48,59 @@ fs::path scans_folder(const fs::path& given, const report::Progress& progress) {
       given.string()));
 }
 
+namespace {
+
+// An Ouster capture streamed: frames assembled packet by packet, never written anywhere.
+void register_capture(const fs::path& pcap, Odometry& odometry, OdometryRun& run,
+                      const report::Progress& progress) {
+  const fs::path json = fs::path(pcap).replace_extension(".json");
+  if (!fs::exists(json)) {
+    throw Error(
+        fmt::format("{}: the capture's metadata {} is not beside it (or convert first: "
+                    "rigcal convert {} --metadata M.json --out RECORDING)",
+                    pcap.string(), json.filename().string(), pcap.string()));
+  }
+  io::OusterPcapReader reader(pcap, io::read_ouster_metadata(json));
+  while (const std::optional<Scan> scan = reader.next_scan()) {
+    run.steps.push_back(register_scan(odometry, *scan));
+    report::tell(progress, "odometry: scans registered", run.steps.size(), 0);
+  }
+  const io::OusterCaptureCounters& c = reader.counters();
+  run.notes.push_back(
+      fmt::format("capture read as it streams: {} frames complete, {} incomplete; "
+                  "{} packets skipped{}{}",
+                  c.frames_complete, c.frames_incomplete, c.skipped_total(),
+                  c.note.empty() ? "" : "; ", c.note));
+}
+
+}  // namespace
+
 OdometryRun run_odometry(const fs::path& scans, const OdometryConfig& config,
                          const report::Progress& progress) {
   const auto started = std::chrono::steady_clock::now();
   OdometryRun run;
   run.scans = scans;
   run.config = config;
-  const io::StampedFolder folder = io::read_stamped_folder(scans, scan_extension(scans));
   Odometry odometry = start_odometry(config);
-  size_t without_times = 0;
-  for (size_t k = 0; k < folder.files.size(); ++k) {
-    Scan scan = io::read_scan(folder.files[k]);
-    if (scan.points.empty()) throw Error(fmt::format("{}: no points", folder.files[k]));
-    scan.stamp = folder.stamps[k];
-    without_times += !scan.point_times;
-    run.steps.push_back(register_scan(odometry, scan));
-    report::tell(progress, "odometry: scans registered", k + 1, folder.files.size());
-  }
-  if (without_times > 0) {
-    run.notes.push_back(fmt::format(
-        "{} of {} scans have no per-point times (KITTI points, PCD): they are registered as "
-        "measured, not deskewed",
-        without_times, folder.files.size()));
+  if (fs::is_regular_file(scans) && io::is_pcap_capture(scans)) {
+    register_capture(scans, odometry, run, progress);
+  } else {
+    const io::StampedFolder folder = io::read_stamped_folder(scans, scan_extension(scans));
+    size_t without_times = 0;
+    for (size_t k = 0; k < folder.files.size(); ++k) {
+      Scan scan = io::read_scan(folder.files[k]);
+      if (scan.points.empty()) throw Error(fmt::format("{}: no points", folder.files[k]));
+      scan.stamp = folder.stamps[k];
+      without_times += !scan.point_times;
+      run.steps.push_back(register_scan(odometry, scan));
+      report::tell(progress, "odometry: scans registered", k + 1, folder.files.size());
+    }
+    if (without_times > 0) {
+      run.notes.push_back(fmt::format(
+          "{} of {} scans have no per-point times (KITTI points, PCD): they are registered as "
+          "measured, not deskewed",
+          without_times, folder.files.size()));
+    }
   }
   run.T_odom_lidar = odometry.T_odom_lidar;
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();

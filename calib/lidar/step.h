@@ -11,10 +11,11 @@
 
 namespace rigcal::lidar {
 
-// The scans a path given by the user stands for: a topic folder itself (data/ with .bin or .pcd
-// and timestamps.txt), else its ouster_points/ (a recording), else the ouster_points/ of the
-// session's motion recording, then of its lidar_camera recording (io::read_session: bags and
-// captures are converted first). Throws rigcal::Error saying what was looked for.
+// The scans a path given by the user stands for: an Ouster capture itself (CAPTURE.pcap, read as
+// it streams with CAPTURE.json beside it), a topic folder (data/ with .bin or .pcd and
+// timestamps.txt), else its ouster_points/ (a recording), else the ouster_points/ of the
+// session's motion recording, then of its lidar_camera recording (io::read_session: bags are
+// converted first). Throws rigcal::Error saying what was looked for.
 std::filesystem::path scans_folder(const std::filesystem::path& given,
                                    const report::Progress& progress = {});
 
@@ -27,8 +28,9 @@ struct OdometryRun {
   double seconds = 0;
 };
 
-// Reads and registers every scan of `scans` in stamp order; the stamps of timestamps.txt are
-// taken as each sweep's first point, the time its per-point times count from. Throws
+// Reads and registers every scan of `scans` (a folder or a capture, as scans_folder gives) in
+// stamp order; the stamps of timestamps.txt are taken as each sweep's first point, the time its
+// per-point times count from (a capture's are the sensor's, its first valid column's). Throws
 // rigcal::Error naming the file on a scan not read.
 OdometryRun run_odometry(const std::filesystem::path& scans, const OdometryConfig& config,
                          const report::Progress& progress = {});

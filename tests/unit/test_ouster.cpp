@@ -2,6 +2,7 @@
 // every field image of every frame against the sdk's md5 digests, the CRC-64 of FW 3 packets,
 // IPv4 fragment reassembly, empty, cut and mismatched captures, the geometry of three frames
 // against the poses published with them, and the IMU packets.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
@@ -16,6 +17,7 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "cli_run.h"
 #include "fixtures.h"
 #include "rigcal/core/error.h"
 #include "rigcal/io/files.h"
@@ -28,6 +30,7 @@
 namespace rigcal {
 namespace {
 
+namespace fs = std::filesystem;
 using io::OusterField;
 using io::OusterFrame;
 using io::OusterMetadata;
@@ -858,6 +861,39 @@ TEST(OusterGeometry, TheOdometryOfTheThreeFramesAgreesWithThePublishedPoses) {
   EXPECT_LT(d02, 0.03);
   EXPECT_LT(max_translation_m, 0.05);
   EXPECT_LT(max_rotation_deg, 0.5);
+}
+
+// `rigcal odometry CAPTURE.pcap` reads the capture as it streams (CAPTURE.json beside it): the
+// same trajectory, to the last bit, as on the capture's conversion and as a second run.
+TEST_F(OusterPcapFiles, TheOdometryOfACaptureStreamsAndRepeatsToTheBit) {
+  RIGCAL_REQUIRE_FIXTURE(pcap, "lidar/ouster_os1_128/OS-1-128_v2.3.0_1024x10_lb_n3.pcap");
+  RIGCAL_REQUIRE_FIXTURE(json, "lidar/ouster_os1_128/OS-1-128_v2.3.0_1024x10.json");
+  const fs::path capture = dir_ / "capture.pcap";
+  fs::create_symlink(pcap, capture);
+  fs::create_symlink(json, dir_ / "capture.json");
+  auto odometry = [&](const fs::path& input, const std::string& out) {
+    const testing::CliRun r = testing::rigcal_cli(
+        fmt::format("odometry {} --sensor os1-64 --out {}", input.string(), (dir_ / out).string()),
+        dir_);
+    EXPECT_EQ(r.status, 0) << r.err;
+    return testing::slurp(dir_ / out);
+  };
+  const std::string streamed = odometry(capture, "a.tum");
+  EXPECT_EQ(std::count(streamed.begin(), streamed.end(), '\n'), 3);
+  EXPECT_EQ(odometry(capture, "b.tum"), streamed);
+  const testing::CliRun c =
+      testing::rigcal_cli(fmt::format("convert {} --metadata {} --out {}", capture.string(),
+                                      (dir_ / "capture.json").string(), (dir_ / "rec").string()),
+                          dir_);
+  ASSERT_EQ(c.status, 0) << c.err;
+  EXPECT_EQ(odometry(dir_ / "rec", "c.tum"), streamed);
+  // Without its metadata beside it: exit 2, what is missing named.
+  fs::remove(dir_ / "capture.json");
+  const testing::CliRun none = testing::rigcal_cli(
+      fmt::format("odometry {} --out {}", capture.string(), (dir_ / "d.tum").string()), dir_);
+  EXPECT_EQ(none.status, 2);
+  EXPECT_NE(none.err.find("capture.json is not beside it"), std::string::npos) << none.err;
+  EXPECT_FALSE(fs::exists(dir_ / "d.tum"));
 }
 
 TEST(OusterGeometry, PointTimesLieInTheSweepAndIncreaseWithColumn) {
