@@ -42,10 +42,11 @@ void run(const Options& o) {
     steps.push_back({run.steps[k - 1].stamp, run.steps[k].stamp, run.steps[k].covariance_prev_cur});
   files[0].content = io::trajectory_to_tum(run.T_odom_lidar);
   files[1].content = io::step_covariances_to_text(steps);
-  if (!o.report.empty()) files[2].content = lidar::odometry_report(run).dump(1) + "\n";
+  const nlohmann::json report = lidar::odometry_report(run);
+  if (!o.report.empty()) files[2].content = report.dump(1) + "\n";
   io::write_files_atomic(files);
 
-  const nlohmann::json summary = lidar::odometry_report(run)["summary"];
+  const nlohmann::json& summary = report["summary"];
   fmt::print("scans: {} ({} registered), path length {:.2f} m, {:.1f} ms a scan (max {:.1f} ms)\n",
              run.scans.string(), run.steps.size(), summary["path_length_m"].get<double>(),
              1e3 * summary["registration_seconds_mean"].get<double>(),

@@ -25,10 +25,13 @@ constexpr size_t kMaxRecordBytes = 1 << 16;
 constexpr long long kMaxPcdPoints = 4'294'967'295LL;
 constexpr size_t kMaxPcdFields = 1024;
 
+bool no_return(double x, double y, double z) {
+  return !std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z) ||
+         (x == 0 && y == 0 && z == 0);
+}
+
 void keep(std::vector<Eigen::Vector3d>& out, double x, double y, double z) {
-  if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) return;
-  if (x == 0 && y == 0 && z == 0) return;
-  out.emplace_back(x, y, z);
+  if (!no_return(x, y, z)) out.emplace_back(x, y, z);
 }
 
 // A field of a ROS PointCloud2 as vbr-devkit's .metadata.json lists it.
@@ -140,11 +143,6 @@ T saturated(double v) {
   if (v <= low) return std::numeric_limits<T>::lowest();
   if (v >= high) return std::numeric_limits<T>::max();
   return static_cast<T>(std::is_integral_v<T> ? std::round(v) : v);
-}
-
-bool no_return(double x, double y, double z) {
-  return !std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z) ||
-         (x == 0 && y == 0 && z == 0);
 }
 
 // KITTI points, or vbr-devkit's full records where its metadata describes them.

@@ -67,15 +67,4 @@ std::vector<Eigen::Vector3d> deskewed_points(const Scan& scan, const SE3& T_star
   return deskew(kept, T_start_next, period_s, scan.point_times);
 }
 
-std::vector<Eigen::Vector3d> voxel_downsample(const std::vector<Eigen::Vector3d>& points,
-                                              double voxel_size) {
-  std::unordered_set<Eigen::Vector3i, VoxelHash> seen;
-  seen.reserve(points.size());
-  std::vector<Eigen::Vector3d> out;
-  out.reserve(points.size() / 2);
-  for (const Eigen::Vector3d& p : points)
-    if (seen.insert(voxel_of(p, voxel_size)).second) out.push_back(p);
-  return out;
-}
-
 }  // namespace rigcal::lidar

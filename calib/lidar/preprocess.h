@@ -33,8 +33,4 @@ std::vector<Eigen::Vector3d> deskew(const std::vector<ScanPoint>& points, const 
 std::vector<Eigen::Vector3d> deskewed_points(const Scan& scan, const SE3& T_start_next,
                                              double period_s, double min_range, double max_range);
 
-// The first point of every voxel of the given size, in input order.
-std::vector<Eigen::Vector3d> voxel_downsample(const std::vector<Eigen::Vector3d>& points,
-                                              double voxel_size);
-
 }  // namespace rigcal::lidar

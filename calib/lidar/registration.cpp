@@ -101,8 +101,7 @@ Registration register_points(const std::vector<Eigen::Vector3d>& points_lidar, c
   out.noise_sigma_m = std::sqrt(normal.sum_wr2 / std::max(normal.sum_w - 6.0, 1.0));
   out.residual_rms_m = std::sqrt(normal.sum_r2 / static_cast<double>(normal.n));
   const Matrix6d H_inv = normal.JtWJ.inverse();
-  out.covariance_independent = out.noise_sigma_m * out.noise_sigma_m * H_inv;
-  out.covariance = out.covariance_independent;
+  out.covariance = out.noise_sigma_m * out.noise_sigma_m * H_inv;
   const double G = static_cast<double>(normal.clusters.size());
   if (config.cluster_size_m > 0 && G > 12) {
     // Cluster-robust (sandwich) form: residuals of one cluster may share an error (a map plane
@@ -110,7 +109,6 @@ Registration register_points(const std::vector<Eigen::Vector3d>& points_lidar, c
     Matrix6d B = Matrix6d::Zero();
     for (const auto& [key, g] : normal.clusters) B.noalias() += g * g.transpose();
     out.covariance = G / (G - 1.0) * H_inv * B * H_inv;
-    out.clusters = normal.clusters.size();
   }
   return out;
 }

@@ -35,10 +35,8 @@ struct Registration {
   double noise_sigma_m = 0;
   // covariance of T_odom_lidar in that tangent (rad, m): cluster-robust, H^-1 B H^-1 with B the
   // sum over clusters of their gradients' outer products (G / (G - 1) corrected), where there are
-  // more than 12 clusters; else, and in covariance_independent, noise_sigma^2 * H^-1.
+  // more than 12 clusters; else noise_sigma^2 * H^-1.
   Matrix6d covariance = Matrix6d::Zero();
-  Matrix6d covariance_independent = Matrix6d::Zero();
-  size_t clusters = 0;
   size_t points = 0, correspondences = 0;
   double residual_rms_m = 0;  // over the correspondences, unweighted
   int iterations = 0;
