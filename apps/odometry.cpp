@@ -70,7 +70,8 @@ void add_odometry(CLI::App& app) {
       "the covariance of every step T_prev_cur (text, one line a step), all or nothing.");
   cmd->add_option("recording", o->recording,
                   "a scans folder (data/ + timestamps.txt), a recording with ouster_points/, a "
-                  "session, a ROS1 bag or an Ouster capture")
+                  "session, a ROS1 bag, an Ouster capture or a KITTI sequence (velodyne/ + "
+                  "times.txt)")
       ->required();
   cmd->add_option("--out", o->out, "output trajectory (TUM)")->required();
   cmd->add_option("--covariances", o->covariances,

@@ -68,9 +68,14 @@ ImageSet pair_by_frame_number(
 }
 
 StampedFolder read_stamped_folder(const fs::path& folder, const std::string& extension) {
+  return read_stamped_folder(folder, extension, "data", "timestamps.txt");
+}
+
+StampedFolder read_stamped_folder(const fs::path& folder, const std::string& extension,
+                                  const std::string& files, const std::string& stamps_file) {
   StampedFolder out;
-  out.files = glob_files((folder / "data" / ("*" + extension)).string());
-  const fs::path stamps = folder / "timestamps.txt";
+  out.files = glob_files((folder / files / ("*" + extension)).string());
+  const fs::path stamps = folder / stamps_file;
   const std::string text = read_text_file(stamps);
   for (const TextLine& line : data_lines(text, nullptr)) {
     Time t;
@@ -89,8 +94,8 @@ StampedFolder read_stamped_folder(const fs::path& folder, const std::string& ext
     out.stamps.push_back(t);
   }
   if (out.stamps.size() != out.files.size()) {
-    throw Error(fmt::format("{}: {} stamps in timestamps.txt for {} {} files in data/",
-                            folder.string(), out.stamps.size(), out.files.size(), extension));
+    throw Error(fmt::format("{}: {} stamps in {} for {} {} files in {}/", folder.string(),
+                            out.stamps.size(), stamps_file, out.files.size(), extension, files));
   }
   return out;
 }

@@ -35,6 +35,10 @@ struct StampedFolder {
 };
 StampedFolder read_stamped_folder(const std::filesystem::path& folder,
                                   const std::string& extension);
+// The same for another layout: `files` (a subfolder) and `stamps` (a file) of `folder`. A KITTI
+// odometry sequence is read with ("velodyne", "times.txt"): seconds since the sequence's start.
+StampedFolder read_stamped_folder(const std::filesystem::path& folder, const std::string& extension,
+                                  const std::string& files, const std::string& stamps);
 // For each stamp of `a`, the nearest stamp of `b` within `tolerance`, each of `b` taken once
 // (first come); nullopt where none.
 std::vector<std::optional<size_t>> pair_by_stamp(const std::vector<Time>& a,

@@ -22,12 +22,24 @@ bool is_scan_topic(const fs::path& folder) {
   return fs::is_directory(folder / "data") && fs::exists(folder / "timestamps.txt");
 }
 
-std::string scan_extension(const fs::path& folder) {
-  for (const fs::directory_entry& e : fs::directory_iterator(folder / "data")) {
+// A KITTI odometry sequence: velodyne/ (its .bin scans) and times.txt.
+bool is_kitti_sequence(const fs::path& folder) {
+  return fs::is_directory(folder / "velodyne") && fs::is_regular_file(folder / "times.txt");
+}
+
+std::string scan_extension(const fs::path& folder, const std::string& files) {
+  for (const fs::directory_entry& e : fs::directory_iterator(folder / files)) {
     if (e.path().extension() == ".bin") return ".bin";
     if (e.path().extension() == ".pcd") return ".pcd";
   }
-  throw Error(fmt::format("{}: no .bin or .pcd scans in data/", folder.string()));
+  throw Error(fmt::format("{}: no .bin or .pcd scans in {}/", folder.string(), files));
+}
+
+io::StampedFolder stamped_scans(const fs::path& folder) {
+  if (is_kitti_sequence(folder))
+    return io::read_stamped_folder(folder, scan_extension(folder, "velodyne"), "velodyne",
+                                   "times.txt");
+  return io::read_stamped_folder(folder, scan_extension(folder, "data"));
 }
 
 }  // namespace
@@ -36,6 +48,7 @@ fs::path scans_folder(const fs::path& given, const report::Progress& progress) {
   if (fs::is_regular_file(given) && io::is_pcap_capture(given)) return given;  // read as it is
   if (fs::is_directory(given) && is_scan_topic(given) && !fs::exists(given / "ouster_points"))
     return given;
+  if (is_kitti_sequence(given)) return given;
   if (is_scan_topic(given / "ouster_points")) return given / "ouster_points";
   const io::Session s = io::read_session(given, progress);
   for (const fs::path& recording : {s.motion, s.lidar_camera}) {
@@ -44,7 +57,8 @@ fs::path scans_folder(const fs::path& given, const report::Progress& progress) {
   }
   throw Error(fmt::format(
       "{}: no scans (a folder with data/ and timestamps.txt, a recording with ouster_points/, "
-      "or a session whose motion or lidar_camera recording has one)",
+      "a session whose motion or lidar_camera recording has one, or a KITTI sequence with "
+      "velodyne/ and times.txt)",
       given.string()));
 }
 
@@ -85,7 +99,7 @@ OdometryRun run_odometry(const fs::path& scans, const OdometryConfig& config,
   if (fs::is_regular_file(scans) && io::is_pcap_capture(scans)) {
     register_capture(scans, odometry, run, progress);
   } else {
-    const io::StampedFolder folder = io::read_stamped_folder(scans, scan_extension(scans));
+    const io::StampedFolder folder = stamped_scans(scans);
     size_t without_times = 0;
     for (size_t k = 0; k < folder.files.size(); ++k) {
       Scan scan = io::read_scan(folder.files[k]);

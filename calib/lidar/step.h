@@ -15,7 +15,8 @@ namespace rigcal::lidar {
 // it streams with CAPTURE.json beside it), a topic folder (data/ with .bin or .pcd and
 // timestamps.txt), else its ouster_points/ (a recording), else the ouster_points/ of the
 // session's motion recording, then of its lidar_camera recording (io::read_session: bags are
-// converted first). Throws rigcal::Error saying what was looked for.
+// converted first); or a KITTI odometry sequence (velodyne/ and times.txt, read in place).
+// Throws rigcal::Error saying what was looked for.
 std::filesystem::path scans_folder(const std::filesystem::path& given,
                                    const report::Progress& progress = {});
 

@@ -363,5 +363,62 @@ TEST_F(OdometryOnADrive, TheCommandWritesAllOrNothingAndNamesBadInput) {
   EXPECT_FALSE(fs::exists(out / "x.tum"));
 }
 
+// A KITTI odometry sequence (velodyne/*.bin, times.txt) read in place, on the real KITTI scans
+// of the fixtures: the command's trajectory from the six .bin files is, pose for pose, the
+// library's from the six .pcd files holding the same points; no per-point times is said.
+class KittiSequence : public testing::ScratchTest {};
+
+TEST_F(KittiSequence, IsReadInPlaceAndItsBinAndPcdScansGiveOneTrajectory) {
+  RIGCAL_REQUIRE_FIXTURE(bin, "lidar/kitti00_bin");
+  RIGCAL_REQUIRE_FIXTURE(pcd, "lidar/kitti00_pcd");
+  RIGCAL_REQUIRE_FIXTURE(times, "trajectories/evo/KITTI_00_gt_times.txt");
+  const fs::path sequence = dir_ / "sequence";
+  fs::create_directories(sequence / "velodyne");
+  std::ifstream all_times(times);
+  std::ofstream six_times(sequence / "times.txt");
+  std::vector<Time> stamps;
+  for (int k = 0; k < 6; ++k) {
+    const std::string name = fmt::format("{:06d}", k);
+    fs::create_symlink(fs::path(bin) / (name + ".bin"), sequence / "velodyne" / (name + ".bin"));
+    std::string line;
+    ASSERT_TRUE(std::getline(all_times, line));
+    six_times << line << "\n";
+    stamps.push_back(parse_time(line));
+  }
+  six_times.close();
+  const testing::CliRun run =
+      testing::rigcal_cli(fmt::format("odometry {} --sensor os1-64 --out {}", sequence.string(),
+                                      (dir_ / "kitti.tum").string()),
+                          dir_);
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_NE(run.out.find("6 of 6 scans have no per-point times"), std::string::npos) << run.out;
+  const Trajectory from_bin = io::read_trajectory(dir_ / "kitti.tum").trajectory;
+  ASSERT_EQ(from_bin.size(), 6u);
+  EXPECT_EQ(from_bin.stamps, stamps);
+
+  Odometry odometry = start_odometry(os1_64_car());
+  for (int k = 0; k < 6; ++k) {
+    Scan scan = io::read_scan(fs::path(pcd) / fmt::format("{:06d}.pcd", k));
+    scan.stamp = stamps[k];
+    register_scan(odometry, scan);
+  }
+  for (size_t k = 0; k < 6; ++k) {
+    const SE3 d = odometry.T_odom_lidar.T_world_body[k].inverse() * from_bin.T_world_body[k];
+    EXPECT_LT(d.t.norm(), 1e-6) << k;  // the TUM file's digits
+    EXPECT_LT(rotation_angle(d.R), 1e-6) << k;
+  }
+  EXPECT_GT(from_bin.T_world_body.back().t.norm(), 3.0);  // five steps of a car, not a standstill
+
+  fs::remove(sequence / "times.txt");
+  std::ofstream(sequence / "times.txt") << "0\n0.1\n";
+  const testing::CliRun short_times = testing::rigcal_cli(
+      fmt::format("odometry {} --out {}", sequence.string(), (dir_ / "x.tum").string()), dir_);
+  EXPECT_EQ(short_times.status, 2);
+  EXPECT_NE(short_times.err.find("2 stamps in times.txt for 6 .bin files in velodyne/"),
+            std::string::npos)
+      << short_times.err;
+  EXPECT_FALSE(fs::exists(dir_ / "x.tum"));
+}
+
 }  // namespace
 }  // namespace rigcal::lidar
