@@ -37,22 +37,20 @@ void run(const Options& o) {
   io::refuse_outputs_over_inputs(files, {{"scans", scans}});
 
   const lidar::OdometryRun run = lidar::run_odometry(scans, config, console_progress());
-  std::vector<io::StepCovariance> steps;
-  for (size_t k = 1; k < run.steps.size(); ++k)
-    steps.push_back({run.steps[k - 1].stamp, run.steps[k].stamp, run.steps[k].covariance_prev_cur});
   files[0].content = io::trajectory_to_tum(run.T_odom_lidar);
-  files[1].content = io::step_covariances_to_text(steps);
+  files[1].content = io::step_covariances_to_text(lidar::step_covariances(run));
   const nlohmann::json report = lidar::odometry_report(run);
   if (!o.report.empty()) files[2].content = report.dump(1) + "\n";
   io::write_files_atomic(files);
 
   const nlohmann::json& summary = report["summary"];
   fmt::print("scans: {} ({} registered), path length {:.2f} m, {:.1f} ms a scan (max {:.1f} ms)\n",
-             run.scans.string(), run.steps.size(), summary["path_length_m"].get<double>(),
+             run.scans.string(), run.T_odom_lidar.size(), summary["path_length_m"].get<double>(),
              1e3 * summary["registration_seconds_mean"].get<double>(),
              1e3 * summary["registration_seconds_max"].get<double>());
-  fmt::print("degenerate steps: {}, not converged: {}\n", summary["degenerate_steps"].get<size_t>(),
-             summary["not_converged_steps"].get<size_t>());
+  fmt::print("degenerate steps: {}, not converged: {}, scans skipped: {}\n",
+             summary["degenerate_steps"].get<size_t>(),
+             summary["not_converged_steps"].get<size_t>(), summary["skipped_scans"].get<size_t>());
   for (const std::string& n : run.notes) fmt::print("note: {}\n", n);
   fmt::print("wrote {} (T_odom_lidar at each scan's stamp, TUM) and {}{}\n", o.out, covariances,
              o.report.empty() ? "" : fmt::format("; report {}/odometry.json", o.report));

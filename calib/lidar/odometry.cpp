@@ -31,6 +31,10 @@ Degeneracy degeneracy_of(const Matrix6d& covariance, const Matrix6d& information
   return d;
 }
 
+double seconds_since(std::chrono::steady_clock::time_point started) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+}
+
 }  // namespace
 
 OdometryConfig os0_128_handheld() {
@@ -66,13 +70,14 @@ Step register_scan(Odometry& o, const Scan& scan) {
   const auto started = std::chrono::steady_clock::now();
   const OdometryConfig& c = o.config;
   Trajectory& poses = o.T_odom_lidar;
-  if (!poses.empty() && scan.stamp <= poses.stamps.back()) {
-    throw Error(fmt::format("scan stamped {} s is not after the previous one ({} s)",
-                            scan.stamp.seconds(), poses.stamps.back().seconds()));
-  }
   Step step;
   step.stamp = scan.stamp;
   step.points_in = scan.points.size();
+  if (!poses.empty() && scan.stamp <= poses.stamps.back()) {
+    step.skipped = fmt::format("stamp {} s not after the last registered scan's ({} s)",
+                               to_seconds_text(scan.stamp), to_seconds_text(poses.stamps.back()));
+    return step;
+  }
   // Constant velocity: the last motion, scaled to this scan's time step.
   SE3 T_prev_cur_predicted;
   double period_s = 0;
@@ -113,6 +118,16 @@ Step register_scan(Odometry& o, const Scan& scan) {
     };
     Registration r =
         register_points(source, o.map, T_odom_predicted, 3.0 * sigma, sigma / 3.0, c.registration);
+    if (r.correspondences < c.min_correspondences ||
+        double(r.correspondences) < c.min_overlap * double(source.size())) {
+      step.skipped = fmt::format(
+          "no overlap with the map: {} of {} points near a map plane (at least {} and {:.0f} % "
+          "needed)",
+          r.correspondences, source.size(), c.min_correspondences, 100 * c.min_overlap);
+      step.correspondences = r.correspondences;
+      step.seconds = seconds_since(started);
+      return step;
+    }
     for (int pass = 1; deskew && pass < c.deskew_passes && r.correspondences >= 6; ++pass)
       r = registered(r.T_odom_lidar, T_odom_prev.inverse() * r.T_odom_lidar);
     // The second scan: the first one deskewed with the motion now known, the map rebuilt from
@@ -149,7 +164,7 @@ Step register_scan(Odometry& o, const Scan& scan) {
   remove_far(o.map, T_odom_cur.t, c.max_range_m);
   poses.stamps.push_back(scan.stamp);
   poses.T_world_body.push_back(T_odom_cur);
-  step.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  step.seconds = seconds_since(started);
   return step;
 }
 

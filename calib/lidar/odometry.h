@@ -26,6 +26,11 @@ struct OdometryConfig {
   // A step is called degenerate when the information's weakest direction holds less than this
   // fraction of its strongest (translation and rotation blocks separately).
   double degenerate_ratio = 0.01;
+  // A sweep is skipped (no pose, the map unchanged) when fewer of its registration points than
+  // this fraction, or than `min_correspondences`, find a plane of the map near the prediction:
+  // it shares no surface with the map (a gap in the recording, a blocked sensor).
+  double min_overlap = 0.05;
+  size_t min_correspondences = 30;
 };
 // Presets for the Ouster models of the VBR rig.
 OdometryConfig os0_128_handheld();  // 10 Hz, indoor and outdoor on foot: 0.5 m voxels, 50 m
@@ -46,6 +51,9 @@ struct Degeneracy {
 
 struct Step {
   Time stamp;
+  // Why the sweep has no pose ("" when registered): its stamp is not after the last registered
+  // one, or it shares no surface with the map (OdometryConfig::min_overlap).
+  std::string skipped;
   SE3 T_odom_lidar;
   // Covariance of the relative motion T_prev_cur = T_odom_lidar(prev)^-1 T_odom_lidar(cur) in
   // rigcal's tangent (rotation first, left perturbation, the previous sensor frame), rad and m.
@@ -68,9 +76,10 @@ struct Odometry {
 };
 
 Odometry start_odometry(const OdometryConfig& config);
-// Registers the next scan (stamps strictly increasing; throws rigcal::Error otherwise). The first
-// scan starts the map as measured; the second's registration gives the motion that deskews it,
-// and the map is then rebuilt from both.
+// Registers the next scan. The first scan starts the map as measured; the second's registration
+// gives the motion that deskews it, and the map is then rebuilt from both. A scan stamped at or
+// before the last registered one, or sharing no surface with the map, is skipped (Step::skipped
+// says why): no pose, nothing changed.
 Step register_scan(Odometry& odometry, const Scan& scan);
 
 }  // namespace rigcal::lidar

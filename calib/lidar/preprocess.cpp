@@ -23,7 +23,7 @@ std::vector<ScanPoint> voxel_sample(const std::vector<ScanPoint>& points, double
   for (const ScanPoint& point : points) {
     const Eigen::Vector3d p = point.p.cast<double>();
     const double r2 = p.squaredNorm();
-    if (r2 < min_squared || r2 > max_squared) continue;
+    if (!(r2 >= min_squared && r2 <= max_squared)) continue;  // NaN too
     if (seen.insert(voxel_of(p, voxel_size)).second) out.push_back(point);
   }
   return out;

@@ -64,6 +64,23 @@ fs::path scans_folder(const fs::path& given, const report::Progress& progress) {
 
 namespace {
 
+// Keeps the step; stops the run when the odometry is lost.
+void keep(OdometryRun& run, Step step, const std::string& source) {
+  run.steps.push_back(std::move(step));
+  size_t lost = 0;
+  for (auto s = run.steps.rbegin(); s != run.steps.rend(); ++s, ++lost)
+    if (s->skipped.rfind("no overlap", 0) != 0) break;
+  if (lost >= kMaxScansLost) {
+    throw Error(fmt::format(
+        "{}: the odometry is lost: {} scans in a row share no surface with the map (the first "
+        "stamped {} s, the last registered {}); a gap in the recording, or a blocked sensor",
+        source, lost, to_seconds_text(run.steps[run.steps.size() - lost].stamp),
+        run.steps.size() > lost
+            ? to_seconds_text(run.steps[run.steps.size() - lost - 1].stamp) + " s"
+            : "none"));
+  }
+}
+
 // An Ouster capture streamed: frames assembled packet by packet, never written anywhere.
 void register_capture(const fs::path& pcap, Odometry& odometry, OdometryRun& run,
                       const report::Progress& progress) {
@@ -76,8 +93,8 @@ void register_capture(const fs::path& pcap, Odometry& odometry, OdometryRun& run
   }
   io::OusterPcapReader reader(pcap, io::read_ouster_metadata(json));
   while (const std::optional<Scan> scan = reader.next_scan()) {
-    run.steps.push_back(register_scan(odometry, *scan));
-    report::tell(progress, "odometry: scans registered", run.steps.size(), 0);
+    keep(run, register_scan(odometry, *scan), pcap.string());
+    report::tell(progress, "odometry: scans read", run.steps.size(), 0);
   }
   const io::OusterCaptureCounters& c = reader.counters();
   run.notes.push_back(
@@ -106,8 +123,8 @@ OdometryRun run_odometry(const fs::path& scans, const OdometryConfig& config,
       if (scan.points.empty()) throw Error(fmt::format("{}: no points", folder.files[k]));
       scan.stamp = folder.stamps[k];
       without_times += !scan.point_times;
-      run.steps.push_back(register_scan(odometry, scan));
-      report::tell(progress, "odometry: scans registered", k + 1, folder.files.size());
+      keep(run, register_scan(odometry, scan), folder.files[k]);
+      report::tell(progress, "odometry: scans read", k + 1, folder.files.size());
     }
     if (without_times > 0) {
       run.notes.push_back(fmt::format(
@@ -116,9 +133,27 @@ OdometryRun run_odometry(const fs::path& scans, const OdometryConfig& config,
           without_times, folder.files.size()));
     }
   }
+  size_t skipped = 0;
+  for (const Step& s : run.steps) skipped += !s.skipped.empty();
+  if (skipped > 0) {
+    run.notes.push_back(
+        fmt::format("{} of {} scans skipped, without a pose (the report's rows say why)", skipped,
+                    run.steps.size()));
+  }
   run.T_odom_lidar = odometry.T_odom_lidar;
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return run;
+}
+
+std::vector<io::StepCovariance> step_covariances(const OdometryRun& run) {
+  std::vector<io::StepCovariance> out;
+  const Step* previous = nullptr;
+  for (const Step& s : run.steps) {
+    if (!s.skipped.empty()) continue;
+    if (previous) out.push_back({previous->stamp, s.stamp, s.covariance_prev_cur});
+    previous = &s;
+  }
+  return out;
 }
 
 nlohmann::json odometry_report(const OdometryRun& run) {
@@ -135,13 +170,25 @@ nlohmann::json odometry_report(const OdometryRun& run) {
                  {"deskew_passes", c.deskew_passes},
                  {"plane_neighbours", c.registration.plane_neighbours},
                  {"degenerate_ratio", c.degenerate_ratio}};
-  size_t degenerate = 0, not_converged = 0;
+  size_t degenerate = 0, not_converged = 0, skipped = 0;
   double step_seconds = 0, max_seconds = 0;
   nlohmann::json rows = nlohmann::json::array();
-  for (size_t k = 0; k < run.steps.size(); ++k) {
-    const Step& s = run.steps[k];
+  bool first = true;
+  for (const Step& s : run.steps) {
     step_seconds += s.seconds, max_seconds = std::max(max_seconds, s.seconds);
-    if (k == 0) continue;
+    if (!s.skipped.empty()) {
+      ++skipped;
+      rows.push_back({{"t", s.stamp.seconds()},
+                      {"points_in", s.points_in},
+                      {"correspondences", s.correspondences},
+                      {"skipped", s.skipped},
+                      {"seconds", s.seconds}});
+      continue;
+    }
+    if (first) {  // the first registered scan starts the map: no motion
+      first = false;
+      continue;
+    }
     degenerate += s.degeneracy.degenerate;
     not_converged += !s.converged;
     const Degeneracy& d = s.degeneracy;
@@ -171,6 +218,7 @@ nlohmann::json odometry_report(const OdometryRun& run) {
       {"path_length_m", path_length(run.T_odom_lidar)},
       {"degenerate_steps", degenerate},
       {"not_converged_steps", not_converged},
+      {"skipped_scans", skipped},
       {"seconds", run.seconds},
       {"registration_seconds_mean", run.steps.empty() ? 0.0 : step_seconds / run.steps.size()},
       {"registration_seconds_max", max_seconds}};

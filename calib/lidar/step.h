@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "rigcal/io/odometry_io.h"
 #include "rigcal/lidar/odometry.h"
 #include "rigcal/report/step.h"
 
@@ -20,11 +21,15 @@ namespace rigcal::lidar {
 std::filesystem::path scans_folder(const std::filesystem::path& given,
                                    const report::Progress& progress = {});
 
+// A run stops (rigcal::Error) when this many scans in a row share no surface with the map: the
+// odometry is lost, and a trajectory that jumps would be worse than none.
+inline constexpr size_t kMaxScansLost = 10;
+
 struct OdometryRun {
   std::filesystem::path scans;
   OdometryConfig config;
   Trajectory T_odom_lidar;
-  std::vector<Step> steps;
+  std::vector<Step> steps;         // one a scan read, skipped ones included (Step::skipped)
   std::vector<std::string> notes;  // what the run assumed or could not do
   double seconds = 0;
 };
@@ -35,6 +40,9 @@ struct OdometryRun {
 // rigcal::Error naming the file on a scan not read.
 OdometryRun run_odometry(const std::filesystem::path& scans, const OdometryConfig& config,
                          const report::Progress& progress = {});
+
+// The covariance of every motion between consecutive registered scans (skipped scans have none).
+std::vector<io::StepCovariance> step_covariances(const OdometryRun& run);
 
 // The report: the configuration, a summary (frames, path length, timing, degenerate steps) and
 // one row a step (doc/odometry.md says what each number is).

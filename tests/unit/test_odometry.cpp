@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <random>
 
@@ -337,6 +338,104 @@ TEST_F(OdometryOnADrive, ScansReadWithTheirTimesOrSayTheyHaveNone) {
               std::string::npos)
         << e;
   }
+}
+
+// Points scattered in a ball of 30 m around the sensor: no surface, nothing of the map's.
+Scan scattered_scan(Time stamp, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-30.f, 30.f);
+  Scan scan;
+  scan.stamp = stamp;
+  while (scan.points.size() < 50000) {
+    const Eigen::Vector3f p(u(rng), u(rng), u(rng));
+    if (p.norm() < 30.f)
+      scan.points.push_back({.p = p, .t_ns = int64_t(scan.points.size()) * 2000});
+  }
+  return scan;
+}
+
+// Bad input to the odometry: points that are not numbers, a stamp repeated, a sweep sharing no
+// surface with the map. Each is dropped or skipped and counted, never a jump of the trajectory.
+TEST_F(OdometryOnADrive, BadScansAreSkippedAndCountedNeverAJump) {
+  const io::StampedFolder f = io::read_stamped_folder(scans(), ".bin");
+  std::vector<Scan> sweeps;
+  for (size_t k = 0; k < f.files.size(); ++k) {
+    sweeps.push_back(io::read_scan(f.files[k]));
+    sweeps.back().stamp = f.stamps[k];
+  }
+  Odometry clean = start_odometry(os0_128_handheld());
+  for (const Scan& s : sweeps) EXPECT_EQ(register_scan(clean, s).skipped, "");
+
+  // NaN and infinite coordinates among the points: left out, the same trajectory to the bit.
+  Odometry not_numbers = start_odometry(os0_128_handheld());
+  const float nan = std::numeric_limits<float>::quiet_NaN(),
+              inf = std::numeric_limits<float>::infinity();
+  for (Scan s : sweeps) {
+    for (size_t i = 0; i < s.points.size(); i += 97)
+      s.points.insert(s.points.begin() + i, {.p = Eigen::Vector3f(nan, 1.f, i % 2 ? inf : 2.f)});
+    s.points.push_back({.p = Eigen::Vector3f(inf, -inf, nan)});
+    EXPECT_EQ(register_scan(not_numbers, s).skipped, "");
+  }
+  EXPECT_EQ(not_numbers.T_odom_lidar.T_world_body, clean.T_odom_lidar.T_world_body);
+
+  // A sweep given twice: the second skipped, the same trajectory to the bit.
+  Odometry repeated = start_odometry(os0_128_handheld());
+  for (size_t k = 0; k < sweeps.size(); ++k) {
+    register_scan(repeated, sweeps[k]);
+    if (k != 5) continue;
+    const Step again = register_scan(repeated, sweeps[k]);
+    EXPECT_NE(again.skipped.find("not after the last registered scan's"), std::string::npos)
+        << again.skipped;
+  }
+  EXPECT_EQ(repeated.T_odom_lidar.T_world_body, clean.T_odom_lidar.T_world_body);
+
+  // Sweep 7 replaced by scattered points: skipped; sweep 8 is registered from sweep 6 (the
+  // constant-velocity guess over two periods) as well as any other step.
+  Odometry gap = start_odometry(os0_128_handheld());
+  Trajectory truth_left = truth();
+  for (size_t k = 0; k < sweeps.size(); ++k) {
+    const Step s = register_scan(gap, k == 7 ? scattered_scan(sweeps[k].stamp, 7) : sweeps[k]);
+    EXPECT_EQ(s.skipped.rfind("no overlap with the map", 0) == 0, k == 7) << k << s.skipped;
+    if (k == 7) std::printf("[ figures ] sweep 7 of scattered points: %s\n", s.skipped.c_str());
+  }
+  truth_left.stamps.erase(truth_left.stamps.begin() + 7);
+  truth_left.T_world_body.erase(truth_left.T_world_body.begin() + 7);
+  ASSERT_EQ(gap.T_odom_lidar.stamps, truth_left.stamps);
+  const Errors e = errors(gap.T_odom_lidar, truth_left);
+  print("sweep 7 skipped", e);
+  EXPECT_LT(e.step_translation_max_m, 0.01);
+  EXPECT_LT(e.end_translation_m, 0.01 * e.length_m);
+
+  // The same through the step: counted in the report, no covariance across nothing; and ten
+  // sweeps in a row without overlap stop the run, naming the folder (never a jump).
+  const fs::path folder = *dir_ / "gap";
+  fs::create_directories(folder / "data");
+  std::ofstream stamps(folder / "timestamps.txt");
+  auto add = [&](const Scan& scan, size_t k) {
+    const fs::path bin = folder / "data" / fmt::format("{:06d}.bin", k);
+    std::ofstream out(bin, std::ios::binary);
+    for (const ScanPoint& p : scan.points) {
+      const float xyzi[4] = {p.p.x(), p.p.y(), p.p.z(), 0.f};
+      out.write(reinterpret_cast<const char*>(xyzi), sizeof xyzi);
+    }
+    stamps << to_seconds_text(scan.stamp) << "\n" << std::flush;
+  };
+  for (size_t k = 0; k < 7; ++k) add(k == 3 ? scattered_scan(sweeps[k].stamp, 3) : sweeps[k], k);
+  const OdometryRun run = run_odometry(folder, os0_128_handheld());
+  EXPECT_EQ(run.T_odom_lidar.size(), 6u);
+  EXPECT_EQ(step_covariances(run).size(), 5u);
+  const nlohmann::json report = odometry_report(run);
+  EXPECT_EQ(report["summary"]["skipped_scans"], 1);
+  EXPECT_EQ(report["steps"].size(), 6u);  // the skipped one and five motions
+  EXPECT_EQ(report["steps"][2]["skipped"].get<std::string>().rfind("no overlap", 0), 0u);
+  EXPECT_NE(nlohmann::json(run.notes).dump().find("1 of 7 scans skipped"), std::string::npos);
+  for (size_t k = 7; k < 17; ++k)
+    add(scattered_scan(sweeps[0].stamp + Time::from_seconds(k), k), k);
+  const std::string lost =
+      testing::error_message_of([&] { run_odometry(folder, os0_128_handheld()); });
+  EXPECT_NE(lost.find(": the odometry is lost: 10 scans in a row share no surface with the map"),
+            std::string::npos)
+      << lost;
 }
 
 TEST_F(OdometryOnADrive, TheCommandWritesAllOrNothingAndNamesBadInput) {
