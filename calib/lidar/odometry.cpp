@@ -40,12 +40,14 @@ double seconds_since(std::chrono::steady_clock::time_point started) {
 OdometryConfig os0_128_handheld() {
   OdometryConfig c;
   c.voxel_size_m = 0.5, c.max_range_m = 50.0, c.min_range_m = 0.5;
+  c.step_sigma_floor_deg = 0.01, c.step_sigma_floor_m = 0.0;
   return c;
 }
 
 OdometryConfig os1_64_car() {
   OdometryConfig c;
   c.voxel_size_m = 1.0, c.max_range_m = 100.0, c.min_range_m = 1.0;
+  c.step_sigma_floor_deg = 0.01, c.step_sigma_floor_m = 0.0005;
   return c;
 }
 
@@ -145,6 +147,11 @@ Step register_scan(Odometry& o, const Scan& scan) {
     Matrix6d A = Matrix6d::Zero();
     A.topLeftCorner<3, 3>() = A.bottomRightCorner<3, 3>() = T_odom_prev.R.transpose();
     step.covariance_prev_cur = A * r.covariance * A.transpose();
+    const double floor_rad = c.step_sigma_floor_deg * M_PI / 180.0;
+    step.covariance_prev_cur.diagonal() +=
+        (Vector6d() << Eigen::Vector3d::Constant(floor_rad * floor_rad),
+         Eigen::Vector3d::Constant(c.step_sigma_floor_m * c.step_sigma_floor_m))
+            .finished();
     step.degeneracy = degeneracy_of(step.covariance_prev_cur, r.information, c.degenerate_ratio);
     step.correspondences = r.correspondences;
     step.residual_rms_m = r.residual_rms_m;

@@ -31,6 +31,10 @@ struct OdometryConfig {
   // it shares no surface with the map (a gap in the recording, a blocked sensor).
   double min_overlap = 0.05;
   size_t min_correspondences = 30;
+  // Added to every step's covariance (1 sigma on each rotation and translation axis): the errors
+  // the registration's information does not hold (the map's own, from the earlier poses; the
+  // deskew's). Set on simulated street drives (seeds 1-5), checked on others (doc/odometry.md).
+  double step_sigma_floor_deg = 0.01, step_sigma_floor_m = 0.001;
 };
 // Presets for the Ouster models of the VBR rig.
 OdometryConfig os0_128_handheld();  // 10 Hz, indoor and outdoor on foot: 0.5 m voxels, 50 m

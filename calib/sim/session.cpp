@@ -183,14 +183,15 @@ TrajectoryPart simulate_trajectories(const rig::Rig& rig, const SimConfig& cfg,
   return part;
 }
 
-ScanPart simulate_scans(const rig::Rig& rig, const SimConfig& cfg) {
-  std::mt19937_64 rng = part_rng(cfg.seed, "scans");
-  ScanPart part;
+StreetDrive street_drive(const rig::Rig& rig, const SimConfig& cfg) {
+  StreetDrive drive;
+  std::mt19937_64& rng = drive.rng;
+  rng = part_rng(cfg.seed, "scans");
+  Scene& scene = drive.scene;
   Motion motion = random_motion(MotionKind::car, cfg.scans / cfg.lidar.rate_hz + 2.0, rng);
   motion.speed = 5.0;
   prepare(motion, cfg.scans / cfg.lidar.rate_hz + 2.0);
   // A street world: ground, box buildings on both sides of the path, poles, clutter.
-  Scene scene;
   SE3 T_ground;
   T_ground.t = Eigen::Vector3d(0, 0, -1.8 - 0.05);
   add_box(scene, T_ground, Eigen::Vector3d(400, 400, 0.05), 0.2);
@@ -228,12 +229,28 @@ ScanPart simulate_scans(const rig::Rig& rig, const SimConfig& cfg) {
     }
   }
   const SE3 T_base_lidar = rig::sensor(rig, rig.base_frame).T_base_sensor;
-  auto T_world_lidar = [&](double t) { return evaluate(motion, t).T_world_base * T_base_lidar; };
+  drive.T_world_lidar = [motion, T_base_lidar](double t) {
+    return evaluate(motion, t).T_world_base * T_base_lidar;
+  };
+  drive.lidar = cfg.lidar;
+  drive.base_start_s = cfg.base_start_s;
+  return drive;
+}
+
+Sweep next_sweep(StreetDrive& drive) {
+  const double t0 = 1.0 + drive.next++ / drive.lidar.rate_hz;
+  return {Time::from_seconds(drive.base_start_s + t0), drive.T_world_lidar(t0),
+          sweep(drive.scene, drive.lidar, drive.T_world_lidar, t0, drive.rng)};
+}
+
+ScanPart simulate_scans(const rig::Rig& rig, const SimConfig& cfg) {
+  StreetDrive drive = street_drive(rig, cfg);
+  ScanPart part;
   for (int k = 0; k < cfg.scans; ++k) {
-    const double t0 = 1.0 + k / cfg.lidar.rate_hz;
-    part.stamps.push_back(Time::from_seconds(cfg.base_start_s + t0));
-    part.T_world_lidar.push_back(T_world_lidar(t0));
-    part.scans.push_back(sweep(scene, cfg.lidar, T_world_lidar, t0, rng));
+    Sweep s = next_sweep(drive);
+    part.stamps.push_back(s.stamp);
+    part.T_world_lidar.push_back(s.T_world_lidar);
+    part.scans.push_back(std::move(s.points));
   }
   return part;
 }

@@ -2,6 +2,7 @@
 // A complete simulated session for a rig (doc/simulator.md). Each part is computed on its own,
 // from its own random stream (seed, part), so that selecting parts does not change the others
 // and the same seed gives identical output. calib/io/session_io.h writes the parts to disk.
+#include <functional>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
@@ -88,6 +89,26 @@ struct ScanPart {
   std::vector<SE3> T_world_lidar;  // at the start of each sweep
   std::vector<std::vector<LidarPoint>> scans;
 };
+
+// The street drive of simulate_scans made one sweep at a time, so that a drive of any length
+// needs the memory of one sweep: the world (ground, buildings, poles, parked cars along the
+// path), the sensor's path, and the random stream the sweeps draw from.
+struct StreetDrive {
+  Scene scene;
+  LidarModel lidar;
+  std::function<SE3(double)> T_world_lidar;  // motion time, s
+  double base_start_s = 0;
+  std::mt19937_64 rng;
+  int next = 0;  // the next sweep's index
+};
+StreetDrive street_drive(const rig::Rig& rig, const SimConfig& config);
+struct Sweep {
+  Time stamp;
+  SE3 T_world_lidar;  // at the start of the sweep
+  std::vector<LidarPoint> points;
+};
+// The next sweep of the drive (config.scans of them fit the world built; later ones leave it).
+Sweep next_sweep(StreetDrive& drive);
 
 StereoPart simulate_stereo(const rig::Rig& rig, const SimConfig& config);
 LidarCameraPart simulate_lidar_camera(const rig::Rig& rig, const SimConfig& config);
