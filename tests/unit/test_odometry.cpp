@@ -16,6 +16,7 @@
 
 #include "cli_run.h"
 #include "fixtures.h"
+#include "odometry_honesty.h"
 #include "rigcal/core/error.h"
 #include "rigcal/io/image_sets.h"
 #include "rigcal/io/odometry_io.h"
@@ -258,63 +259,9 @@ TEST_F(OdometryOnADrive, StepCovariancesAgainstTheErrors) {
 // hundredths of a degree in the first ten steps, are far outside (printed): the map's own error
 // is in no registration's information.
 TEST(OdometryHonesty, StepErrorsLieWithinThreeSigmaInAtLeast95PercentOfSteps) {
-  const rig::Rig rig = rig::read_rig_file(RIGCAL_SOURCE_DIR "/data/sample_rig.yaml");
-  constexpr double kChi2_6_3sigma = 20.06;
-  size_t steps = 0, within = 0, steps_late = 0, within_late = 0, within_without_floor = 0;
-  double sum_nees = 0;
-  for (uint64_t seed = 6; seed <= 10; ++seed) {
-    sim::SimConfig config;
-    config.seed = seed;
-    config.scans = 20;
-    config.lidar = sim::os1_64();
-    sim::StreetDrive street = sim::street_drive(rig, config);
-    Odometry odometry = start_odometry(os1_64_car());
-    std::vector<SE3> T_world_lidar;
-    std::vector<double> nees;
-    for (int k = 0; k < config.scans; ++k) {
-      const sim::Sweep sweep = sim::next_sweep(street);
-      Scan scan;
-      scan.stamp = sweep.stamp;
-      for (const sim::LidarPoint& p : sweep.points)
-        scan.points.push_back({.p = p.p, .t_ns = p.t_ns});
-      const Step step = register_scan(odometry, scan);
-      ASSERT_EQ(step.skipped, "");
-      T_world_lidar.push_back(sweep.T_world_lidar);
-      if (k == 0) continue;
-      const std::vector<SE3>& est = odometry.T_odom_lidar.T_world_body;
-      const SE3 T_prev_cur = est[k - 1].inverse() * est[k];
-      const SE3 truth = T_world_lidar[k - 1].inverse() * T_world_lidar[k];
-      Vector6d e;  // T_prev_cur = perturbed(truth, e), the covariance's tangent
-      e.head<3>() = rotation_vector(T_prev_cur.R * truth.R.transpose());
-      e.tail<3>() = T_prev_cur.t - truth.t;
-      nees.push_back(e.dot(step.covariance_prev_cur.ldlt().solve(e)));
-      sum_nees += nees.back();
-      OdometryConfig no_floor = os1_64_car();
-      Matrix6d C = step.covariance_prev_cur;
-      for (int i = 0; i < 3; ++i) {
-        C(i, i) -= std::pow(no_floor.step_sigma_floor_deg * M_PI / 180, 2);
-        C(i + 3, i + 3) -= std::pow(no_floor.step_sigma_floor_m, 2);
-      }
-      within_without_floor += e.dot(C.ldlt().solve(e)) <= kChi2_6_3sigma;
-      ++steps, ++steps_late;
-      within += nees.back() <= kChi2_6_3sigma;
-      if (k < 6) {
-        --steps_late;
-      } else {
-        within_late += nees.back() <= kChi2_6_3sigma;
-      }
-    }
-    std::printf("[ figures ] seed %d: step NEES", int(seed));
-    for (double v : nees) std::printf(" %.1f", v);
-    std::printf("\n");
-  }
-  std::printf(
-      "[ figures ] step errors within 3 sigma (NEES <= 20.06): %zu of %zu steps (%.1f %%), mean "
-      "NEES %.1f; from the sixth step on %zu of %zu (%.1f %%); without the floor %zu of %zu\n",
-      within, steps, 100.0 * within / steps, sum_nees / double(steps), within_late, steps_late,
-      100.0 * within_late / steps_late, within_without_floor, steps);
-  EXPECT_GE(double(within), 0.95 * double(steps));
-  EXPECT_GT(sum_nees / double(steps), 1.0);  // not cautious beyond use (6 would be exact)
+  const HonestyFigures h = odometry_honesty(sim::os1_64(), os1_64_car(), 6, 10, 20);
+  EXPECT_GE(double(h.within), 0.95 * double(h.steps));
+  EXPECT_GT(h.nees_mean, 1.0);  // not cautious beyond use (6 would be exact)
 }
 
 // A corridor longer than the sensor's reach (walls 1.5 m to each side, floor and ceiling, the
