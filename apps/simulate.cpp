@@ -84,19 +84,29 @@ void run(const Options& o) {
         io::write_lidar_camera(tmp, sim::simulate_lidar_camera(rig, config), truth);
       if (part == "imu") io::write_imu(tmp, sim::simulate_imu_part(rig, config), truth);
       if (part == "trajectories") {
-        io::write_trajectories(
-            tmp,
-            sim::simulate_trajectories(rig, config, config.replay_tum.empty() ? nullptr : &replay),
-            truth);
+        const sim::TrajectoryPart t =
+            sim::simulate_trajectories(rig, config, config.replay_tum.empty() ? nullptr : &replay);
+        io::write_trajectories(tmp, t, truth);
+        if (config.trajectory_scans) {
+          sim::SweepDrive drive = sim::trajectory_drive(rig, config, t);
+          io::write_trajectory_scans(tmp, drive, t.truth_base.size(), truth,
+                                     [](size_t done, size_t total) {
+                                       if (done % 100 == 0 || done == total) {
+                                         fmt::print(" {}/{} sweeps", done, total);
+                                         std::fflush(stdout);
+                                       }
+                                     });
+        }
       }
       if (part == "scans") io::write_scans(tmp, sim::simulate_scans(rig, config), truth);
       fmt::print(" {:.1f} s\n",
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     }
-    io::write_files_atomic({{tmp / "truth.yaml", rig::rig_to_yaml(rig)},
-                            {tmp / "truth.json", report::json_text(truth)},
-                            {tmp / "target.yaml", io::target_to_yaml(config.target)},
-                            {tmp / "session.yaml", io::simulated_session_yaml(parts)}});
+    io::write_files_atomic(
+        {{tmp / "truth.yaml", rig::rig_to_yaml(rig)},
+         {tmp / "truth.json", report::json_text(truth)},
+         {tmp / "target.yaml", io::target_to_yaml(config.target)},
+         {tmp / "session.yaml", io::simulated_session_yaml(parts, config.trajectory_scans)}});
     if (fs::exists(out, ec)) fs::remove_all(out);
     fs::rename(tmp, out);
   } catch (...) {
@@ -117,6 +127,7 @@ void add_simulate(CLI::App& app) {
       "  lidar-camera  scans and images of the target on a stand in a room\n"
       "  imu           two IMU streams of one hand-held motion, on their own clocks\n"
       "  trajectories  true LiDAR poses, drifting LiDAR odometry, GNSS/INS with RTK noise\n"
+      "                (trajectories.scans: true in --config adds sweeps along the motion)\n"
       "  scans         LiDAR sweeps along a drive through a street of box buildings\n"
       "The true rig goes to truth.yaml, the rest of the truth to truth.json. The same seed gives\n"
       "byte-identical files.");

@@ -53,7 +53,7 @@ void write_points(const fs::path& dir, const std::vector<Time>& stamps,
 
 }  // namespace
 
-std::string simulated_session_yaml(const std::vector<std::string>& parts) {
+std::string simulated_session_yaml(const std::vector<std::string>& parts, bool trajectory_scans) {
   auto has = [&](std::string_view p) {
     return std::find(parts.begin(), parts.end(), p) != parts.end();
   };
@@ -62,12 +62,14 @@ std::string simulated_session_yaml(const std::vector<std::string>& parts) {
       "target: target.yaml\n";
   if (has("stereo")) out += "cameras: stereo\n";
   if (has("lidar-camera")) out += "lidar_camera: lidar_camera\n";
-  if (has("imu")) out += "motion: .\n";
+  trajectory_scans = trajectory_scans && has("trajectories");
+  if (has("imu") || trajectory_scans) out += "motion: .\n";
   if (has("trajectories")) {
-    out +=
-        "# The LiDAR odometry stands in for rigcal's own until it has one.\n"
-        "odometry: trajectories/lidar_odometry.tum\n"
-        "gnss: trajectories/gnss_ins.tum\n";
+    out += trajectory_scans
+               ? "# No odometry named: rigcal's own runs on the motion's sweeps (ouster_points/).\n"
+               : "# A simulated LiDAR odometry (no sweeps were simulated along the motion).\n"
+                 "odometry: trajectories/lidar_odometry.tum\n";
+    out += "gnss: trajectories/gnss_ins.tum\n";
   }
   return out;
 }
@@ -178,6 +180,25 @@ void write_trajectories(const fs::path& dir, const sim::TrajectoryPart& part,
   j["files"] = {{"truth_lidar.tum", "T_world_lidar, the truth, LiDAR rate"},
                 {"lidar_odometry.tum", "T_odom_lidar, drifting odometry"},
                 {"gnss_ins.tum", "T_enu_gnss on the GNSS clock, with noise, outages, outliers"}};
+}
+
+void write_trajectory_scans(const fs::path& dir, sim::SweepDrive& drive, size_t count,
+                            nlohmann::json& truth,
+                            const std::function<void(size_t, size_t)>& progress) {
+  const fs::path out = dir / "ouster_points";
+  std::vector<Time> stamps;
+  for (size_t k = 0; k < count; ++k) {
+    const sim::Sweep s = sim::next_sweep(drive);
+    stamps.push_back(s.stamp);
+    write_files_atomic({{out / "data" / frame_name(k, "bin"), points_bin(s.points)},
+                        {out / "fields" / frame_name(k, "bin"), fields_bin(s.points)}});
+    if (progress) progress(k + 1, count);
+  }
+  write_file_atomic(out / "timestamps.txt", timestamps_txt(stamps));
+  truth["trajectories"]["scans"] = {
+      {"folder", "ouster_points"},
+      {"count", count},
+      {"poses", "trajectories/truth_lidar.tum: sweep k starts at pose k"}};
 }
 
 void write_scans(const fs::path& dir, const sim::ScanPart& part, nlohmann::json& truth) {

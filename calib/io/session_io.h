@@ -3,11 +3,13 @@
 //   stereo/camera_left|camera_right/{timestamps.txt, data/%010d.png, corners_truth.csv}
 //   lidar_camera/<camera>/..., lidar_camera/ouster_points/{timestamps.txt, data/%010d.bin,
 //   fields/%010d.bin} imu/{timestamps.txt, data/imu.txt}, ouster_imu/{...}
-//   trajectories/{truth_lidar.tum, lidar_odometry.tum, gnss_ins.tum}
+//   trajectories/{truth_lidar.tum, lidar_odometry.tum, gnss_ins.tum}, ouster_points/{...} (sweeps
+//   along the trajectory, when asked)
 //   scans/ouster_points/{...}, scans/truth_lidar.tum
 //   truth.yaml (the true rig), truth.json (per-item truth)
 // Paths are relative to one output folder; callers write into a temporary folder and rename it.
 #include <filesystem>
+#include <functional>
 #include <nlohmann/json.hpp>
 
 #include "rigcal/sim/session.h"
@@ -23,11 +25,19 @@ void write_trajectories(const std::filesystem::path& dir, const sim::TrajectoryP
                         nlohmann::json& truth);
 void write_scans(const std::filesystem::path& dir, const sim::ScanPart& part,
                  nlohmann::json& truth);
+// `count` sweeps of the drive (sim::trajectory_drive) as the motion recording's ouster_points/,
+// made and written one at a time (a sweep's memory, whatever the length); `progress` is told
+// after each.
+void write_trajectory_scans(const std::filesystem::path& dir, sim::SweepDrive& drive, size_t count,
+                            nlohmann::json& truth,
+                            const std::function<void(size_t done, size_t total)>& progress = {});
 
 // session.yaml of a simulated session (doc/session.md) with the parts written ("stereo",
 // "lidar-camera", "imu", "trajectories", "scans"): the recordings of each step, target.yaml, and
-// the motion's odometry and GNSS/INS trajectories; the truth is not named as a prior rig.
-std::string simulated_session_yaml(const std::vector<std::string>& parts);
+// the motion's GNSS/INS trajectory, and its odometry unless the motion recording has sweeps
+// (`trajectory_scans`: rigcal's own odometry runs on them); the truth is not named as a prior rig.
+std::string simulated_session_yaml(const std::vector<std::string>& parts,
+                                   bool trajectory_scans = false);
 
 // The vbr-devkit IMU layout: timestamps.txt (ISO-8601 a line) and data/imu.txt (a header line,
 // then 37 comma-separated columns: acc xyz, gyro xyz, orientation wxyz, three 3x3 covariances).

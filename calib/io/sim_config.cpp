@@ -40,6 +40,7 @@ void apply_sim_config(std::string_view text, std::string_view file, sim::SimConf
       v = x;
     });
   };
+  int columns = 0;  // lidar.columns, applied after lidar.model
   auto integer = [&](int& v, int low, int high) {
     return Setter([&v, low, high, in_range](const YAML::Node& n) {
       const double x = n.as<double>();
@@ -70,8 +71,10 @@ void apply_sim_config(std::string_view text, std::string_view file, sim::SimConf
         v = sim::MotionKind::handheld;
       else if (s == "car")
         v = sim::MotionKind::car;
+      else if (s == "walk")
+        v = sim::MotionKind::walk;
       else
-        throw Error(fmt::format("expected handheld or car, got '{}'", s));
+        throw Error(fmt::format("expected handheld, car or walk, got '{}'", s));
     });
   };
   auto imu = [&](const std::string& p, sim::ImuSimConfig& v) {
@@ -115,6 +118,7 @@ void apply_sim_config(std::string_view text, std::string_view file, sim::SimConf
          c.lidar.range_noise_m = noise;
        })},
       {"lidar.range_noise_m", num(c.lidar.range_noise_m, 0, 10)},
+      {"lidar.columns", integer(columns, 64, 4096)},
       {"lidar_camera.pairs", integer(c.lidar_camera_pairs, 1, 200)},
       {"lidar_camera.camera",
        Setter([&](const YAML::Node& n) { c.lidar_camera_camera = n.as<std::string>(); })},
@@ -123,6 +127,7 @@ void apply_sim_config(std::string_view text, std::string_view file, sim::SimConf
       {"imu_motion", motion(c.imu_motion)},
       {"trajectories.duration_s", num(c.trajectory_duration_s, 1, 36000)},
       {"trajectories.motion", motion(c.trajectory_motion)},
+      {"trajectories.scans", flag(c.trajectory_scans)},
       {"trajectories.replay",
        Setter([&](const YAML::Node& n) { c.replay_tum = (base / n.as<std::string>()).string(); })},
       {"trajectories.odometry.trans_sigma_m", num(c.odometry.trans_sigma_m, 0, 10)},
@@ -163,6 +168,7 @@ void apply_sim_config(std::string_view text, std::string_view file, sim::SimConf
     }
   };
   walk(root, "");
+  if (columns > 0) c.lidar.columns = columns;  // whichever of lidar.model and it comes first
 }
 
 void read_sim_config(const std::filesystem::path& path, sim::SimConfig& config) {

@@ -2,7 +2,9 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace rigcal::sim {
 
@@ -83,6 +85,16 @@ void add_room(Scene& scene, double hx, double hy, double z_floor, double z_ceili
 LidarModel os0_128() { return {128, 90.0, 2048, 10.0, 0.01, 0.3, 50.0}; }
 LidarModel os1_64() { return {64, 45.0, 1024, 20.0, 0.01, 0.5, 120.0}; }
 
+namespace {
+
+// A rectangle's bounding sphere radius and its highest point.
+double radius(const Rect& r) { return std::hypot(r.half_u, r.half_v); }
+double top_z(const Rect& r) {
+  return r.centre.z() + std::abs(r.u.z()) * r.half_u + std::abs(r.v.z()) * r.half_v;
+}
+
+}  // namespace
+
 std::vector<LidarPoint> sweep(const Scene& scene, const LidarModel& m,
                               const std::function<SE3(double)>& T_world_lidar, double t0,
                               std::mt19937_64& rng) {
@@ -90,6 +102,53 @@ std::vector<LidarPoint> sweep(const Scene& scene, const LidarModel& m,
   std::vector<std::vector<LidarPoint>> columns(m.columns);
   std::vector<SE3> poses(m.columns);
   for (int c = 0; c < m.columns; ++c) poses[c] = T_world_lidar(t0 + period * c / m.columns);
+  // The rectangles a ray of this sweep can reach, nearest first by a lower bound of their
+  // distance from any of the sweep's origins; a ray stops once that bound passes its best hit.
+  // Ties keep the scene's order (the later rectangle wins, as in a scan of all of them), so the
+  // result is the same as testing every rectangle.
+  double travel = 0;
+  for (const SE3& T : poses) travel = std::max(travel, (T.t - poses[0].t).norm());
+  struct Candidate {
+    const Rect* rect;
+    size_t index;
+    double lower_bound;
+  };
+  std::vector<Candidate> near;
+  double z_top = -std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < scene.rects.size(); ++i) {
+    const Rect& r = scene.rects[i];
+    const double lb = (r.centre - poses[0].t).norm() - radius(r) - travel;
+    if (lb > m.max_range_m) continue;
+    near.push_back({&r, i, lb});
+    z_top = std::max(z_top, top_z(r));
+  }
+  std::sort(near.begin(), near.end(), [](const Candidate& a, const Candidate& b) {
+    return a.lower_bound < b.lower_bound || (a.lower_bound == b.lower_bound && a.index < b.index);
+  });
+  // And by the azimuth of their bounding spheres seen from above: a ray heading (in the world's
+  // x-y plane) within a sector meets only the rectangles whose azimuth span overlaps it (seen from
+  // the sweep's first origin, the spheres grown by the sweep's travel).
+  constexpr int kSectors = 128;
+  auto sector_of = [](double azimuth) {
+    const int k = static_cast<int>(std::floor((azimuth + M_PI) / (2.0 * M_PI) * kSectors));
+    return ((k % kSectors) + kSectors) % kSectors;
+  };
+  std::vector<std::vector<Candidate>> sectors(kSectors);
+  for (const Candidate& k : near) {
+    const Eigen::Vector2d dxy = (k.rect->centre - poses[0].t).head<2>();
+    const double reach = radius(*k.rect) + travel, dist = dxy.norm();
+    if (dist <= reach * (1.0 + 1e-9) + 1e-9) {
+      for (std::vector<Candidate>& sec : sectors) sec.push_back(k);
+      continue;
+    }
+    const double azimuth = std::atan2(dxy.y(), dxy.x()), half = std::asin(reach / dist) + 1e-9;
+    const int first =
+        static_cast<int>(std::floor((azimuth - half + M_PI) / (2.0 * M_PI) * kSectors));
+    const int last =
+        static_cast<int>(std::floor((azimuth + half + M_PI) / (2.0 * M_PI) * kSectors));
+    for (int j = first; j <= last && j < first + kSectors; ++j)
+      sectors[((j % kSectors) + kSectors) % kSectors].push_back(k);
+  }
   tbb::parallel_for(0, m.columns, [&](int c) {
     const SE3& T = poses[c];
     // Ouster spins clockwise seen from above: azimuth decreases with the column.
@@ -102,17 +161,25 @@ std::vector<LidarPoint> sweep(const Scene& scene, const LidarModel& m,
                                     std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
       const Eigen::Vector3d o = T.t, d = T.R * d_lidar;
       double best = m.max_range_m;
+      // A ray rising above every rectangle's top cannot hit anything beyond that height.
+      const double limit = d.z() > 1e-9 ? std::min(best, (z_top - o.z()) / d.z() + 1.0) : best;
       const Rect* hit = nullptr;
-      for (const Rect& r : scene.rects) {
+      size_t hit_index = 0;
+      const bool vertical = d.head<2>().norm() < 1e-6;
+      for (const Candidate& k : vertical ? near : sectors[sector_of(std::atan2(d.y(), d.x()))]) {
+        if (k.lower_bound > std::min(best, limit)) break;
+        const Rect& r = *k.rect;
         const Eigen::Vector3d n = r.u.cross(r.v);
         const double denom = n.dot(d);
         if (std::abs(denom) < 1e-12) continue;
         const double s = n.dot(r.centre - o) / denom;
         if (s < m.min_range_m || s > best) continue;
+        if (s == best && hit && k.index < hit_index) continue;
         const Eigen::Vector3d q = o + s * d - r.centre;
         if (std::abs(q.dot(r.u)) > r.half_u || std::abs(q.dot(r.v)) > r.half_v) continue;
         best = s;
         hit = &r;
+        hit_index = k.index;
       }
       if (!hit) continue;
       LidarPoint p;

@@ -49,6 +49,14 @@ Motion random_motion(MotionKind kind, double duration, std::mt19937_64& rng) {
     m.roll = random_sum(rng, 4, 0.40, 0.3, 6.0);
     m.pitch = random_sum(rng, 4, 0.40, 0.3, 6.0);
     m.yaw_rate = random_sum(rng, 4, 0.8, 0.05, 3.0);
+  } else if (kind == MotionKind::walk) {
+    m.speed = 1.3;
+    m.x = random_sum(rng, 2, 0.05, 0.5, 3.0);
+    m.y = random_sum(rng, 2, 0.05, 0.5, 3.0);
+    m.z = random_sum(rng, 2, 0.02, 10.0, 12.0);  // the step's bob, ~1.7 Hz
+    m.roll = random_sum(rng, 3, 0.12, 0.3, 3.0);
+    m.pitch = random_sum(rng, 3, 0.12, 0.3, 3.0);
+    m.yaw_rate = random_sum(rng, 3, 0.4, 0.05, 1.0);
   } else {
     m.speed = 8.0;
     m.x = random_sum(rng, 2, 0.05, 0.2, 1.0);

@@ -10,9 +10,12 @@
 namespace rigcal::sim {
 
 enum class MotionKind {
-  handheld,  // walking at ~1.3 m/s with a turning path, bobbing, rich rotation (+-25 deg
-             // roll/pitch)
+  handheld,  // the calibration dance: walking at ~1.3 m/s with a turning path, bobbing, rich
+             // rotation (+-25 deg roll/pitch, angular rates to ~3 rad/s): excites IMUs and
+             // hand-eye, and is harder than a constant-velocity deskew can follow
   car,       // planar driving at ~8 m/s with curves; roll/pitch below 1 deg; z nearly constant
+  walk,      // a rig carried while walking at ~1.3 m/s: +-15 deg sway, a 2 cm bob at the step
+             // frequency, turns up to ~1 rad/s
 };
 
 struct Sinusoid {

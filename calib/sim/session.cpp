@@ -2,6 +2,10 @@
 
 #include <fmt/format.h>
 
+#include <limits>
+#include <map>
+#include <set>
+
 #include "rigcal/core/error.h"
 #include "rigcal/io/image_io.h"
 
@@ -172,6 +176,7 @@ TrajectoryPart simulate_trajectories(const rig::Rig& rig, const SimConfig& cfg,
   const double rate = base.update_rate.value_or(10.0);
   const Time start = Time::from_seconds(cfg.base_start_s);
   part.truth_base = sample_poses(source, rate, duration, start);
+  part.source = source;
   part.odometry = simulate_odometry(part.truth_base, cfg.odometry, rng);
   part.T_enu_world =
       SE3::from_rotation_vector(Eigen::Vector3d(0, 0, 0.7), Eigen::Vector3d(120.0, -45.0, 21.0));
@@ -183,8 +188,8 @@ TrajectoryPart simulate_trajectories(const rig::Rig& rig, const SimConfig& cfg,
   return part;
 }
 
-StreetDrive street_drive(const rig::Rig& rig, const SimConfig& cfg) {
-  StreetDrive drive;
+SweepDrive street_drive(const rig::Rig& rig, const SimConfig& cfg) {
+  SweepDrive drive;
   std::mt19937_64& rng = drive.rng;
   rng = part_rng(cfg.seed, "scans");
   Scene& scene = drive.scene;
@@ -237,14 +242,100 @@ StreetDrive street_drive(const rig::Rig& rig, const SimConfig& cfg) {
   return drive;
 }
 
-Sweep next_sweep(StreetDrive& drive) {
-  const double t0 = 1.0 + drive.next++ / drive.lidar.rate_hz;
+SweepDrive trajectory_drive(const rig::Rig& rig, const SimConfig& cfg, const TrajectoryPart& part) {
+  if (part.truth_base.empty() || !part.source)
+    throw Error("sweeps along a trajectory need the trajectories part's poses");
+  SweepDrive drive;
+  std::mt19937_64& rng = drive.rng;
+  rng = part_rng(cfg.seed, "trajectory-scans");
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  // The path every metre or so, in a hash grid of cells as large as the box grid's.
+  constexpr double kCell = 8.0, kReach = 36.0, kClearance = 2.0;
+  std::vector<Eigen::Vector2d> path;
+  double z_min = std::numeric_limits<double>::infinity();
+  for (const SE3& T : part.truth_base.T_world_body) {
+    z_min = std::min(z_min, T.t.z());
+    if (path.empty() || (T.t.head<2>() - path.back()).norm() > 1.0) path.push_back(T.t.head<2>());
+  }
+  auto cell_of = [&](const Eigen::Vector2d& p) {
+    return std::pair<int, int>(static_cast<int>(std::floor(p.x() / kCell)),
+                               static_cast<int>(std::floor(p.y() / kCell)));
+  };
+  std::map<std::pair<int, int>, std::vector<Eigen::Vector2d>> path_cells;
+  Eigen::Vector2d lo = path[0], hi = path[0];
+  for (const Eigen::Vector2d& p : path) {
+    path_cells[cell_of(p)].push_back(p);
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  auto distance_to_path = [&](const Eigen::Vector2d& q, double within) {
+    const auto [cx, cy] = cell_of(q);
+    const int r = static_cast<int>(std::ceil(within / kCell));
+    double best = std::numeric_limits<double>::infinity();
+    for (int i = cx - r; i <= cx + r; ++i) {
+      for (int j = cy - r; j <= cy + r; ++j) {
+        const auto it = path_cells.find({i, j});
+        if (it == path_cells.end()) continue;
+        for (const Eigen::Vector2d& p : it->second) best = std::min(best, (p - q).norm());
+      }
+    }
+    return best;
+  };
+  // The ground below the lowest pose (a LiDAR held or mounted 1.7 m up), wide enough for the
+  // sensor's range.
+  const double z_ground = z_min - 1.7;
+  SE3 T_ground;
+  T_ground.t << 0.5 * (lo + hi), z_ground - 0.05;
+  const Eigen::Vector2d half = 0.5 * (hi - lo) + Eigen::Vector2d::Constant(cfg.lidar.max_range_m);
+  add_box(drive.scene, T_ground, Eigen::Vector3d(half.x(), half.y(), 0.05), 0.2);
+  // A box (sometimes also a pole) in most cells of the grid within kReach of the path, never
+  // nearer than kClearance to it.
+  std::set<std::pair<int, int>> cells;
+  const int reach = static_cast<int>(std::ceil(kReach / kCell));
+  for (const auto& [c, points] : path_cells) {
+    for (int i = -reach; i <= reach; ++i) {
+      for (int j = -reach; j <= reach; ++j) cells.insert({c.first + i, c.second + j});
+    }
+  }
+  for (const auto& [i, j] : cells) {
+    const double yaw = M_PI * U(rng);
+    const Eigen::Vector3d h(0.3 + 3.7 * U(rng), 0.3 + 1.7 * U(rng), 0.5 + 4.5 * U(rng));
+    const Eigen::Vector2d centre((i + U(rng)) * kCell, (j + U(rng)) * kCell);
+    const double reflectivity = 0.2 + 0.5 * U(rng);
+    const bool box = U(rng) < 0.55, pole = U(rng) < 0.25;
+    const Eigen::Vector2d pole_at((i + U(rng)) * kCell, (j + U(rng)) * kCell);
+    if (box && distance_to_path(centre, kReach) > h.head<2>().norm() + kClearance) {
+      SE3 T_box;
+      T_box.R = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+      T_box.t << centre, z_ground + h.z();
+      add_box(drive.scene, T_box, h, reflectivity);
+    }
+    if (pole && distance_to_path(pole_at, kReach) > kClearance) {
+      SE3 T_pole;
+      T_pole.t << pole_at, z_ground + 2.0;
+      add_box(drive.scene, T_pole, Eigen::Vector3d(0.08, 0.08, 2.0), 0.6);
+    }
+  }
+  const SE3 T_base_lidar = rig::sensor(rig, rig.base_frame).T_base_sensor;
+  drive.T_world_lidar = [source = part.source, T_base_lidar](double t) {
+    return source(t) * T_base_lidar;
+  };
+  drive.lidar = cfg.lidar;
+  // A sweep every pose: the rate the poses are sampled at.
+  drive.lidar.rate_hz = rig::sensor(rig, rig.base_frame).update_rate.value_or(10.0);
+  drive.base_start_s = cfg.base_start_s;
+  drive.first_s = 0.0;
+  return drive;
+}
+
+Sweep next_sweep(SweepDrive& drive) {
+  const double t0 = drive.first_s + drive.next++ / drive.lidar.rate_hz;
   return {Time::from_seconds(drive.base_start_s + t0), drive.T_world_lidar(t0),
           sweep(drive.scene, drive.lidar, drive.T_world_lidar, t0, drive.rng)};
 }
 
 ScanPart simulate_scans(const rig::Rig& rig, const SimConfig& cfg) {
-  StreetDrive drive = street_drive(rig, cfg);
+  SweepDrive drive = street_drive(rig, cfg);
   ScanPart part;
   for (int k = 0; k < cfg.scans; ++k) {
     Sweep s = next_sweep(drive);

@@ -47,6 +47,10 @@ struct SimConfig {
   std::string replay_tum;  // non-empty: replay this trajectory instead of a generated motion
   OdometryNoise odometry;
   GnssNoise gnss;
+  // LiDAR sweeps along the trajectory, one at each true pose (the motion recording's
+  // ouster_points/), in a courtyard of boxes around the path: rigcal's own odometry can then run
+  // on them instead of the simulated lidar_odometry.tum.
+  bool trajectory_scans = false;
   // scans along a trajectory in a street world
   int scans = 10;
 };
@@ -82,6 +86,9 @@ struct TrajectoryPart {
   std::vector<size_t> gnss_outliers;
   SE3 T_enu_world;
   std::string gnss_name;
+  // T_world_base at motion time (s); truth_base samples it. A replay's refers to the replayed
+  // trajectory.
+  PoseSource source;
 };
 
 struct ScanPart {
@@ -90,25 +97,34 @@ struct ScanPart {
   std::vector<std::vector<LidarPoint>> scans;
 };
 
-// The street drive of simulate_scans made one sweep at a time, so that a drive of any length
-// needs the memory of one sweep: the world (ground, buildings, poles, parked cars along the
-// path), the sensor's path, and the random stream the sweeps draw from.
-struct StreetDrive {
+// Sweeps made one at a time along a path, so that a drive of any length needs the memory of one
+// sweep: the world, the sensor's path, and the random stream the sweeps draw from.
+struct SweepDrive {
   Scene scene;
   LidarModel lidar;
   std::function<SE3(double)> T_world_lidar;  // motion time, s
   double base_start_s = 0;
+  double first_s = 1.0;  // motion time of the first sweep's start
   std::mt19937_64 rng;
   int next = 0;  // the next sweep's index
 };
-StreetDrive street_drive(const rig::Rig& rig, const SimConfig& config);
+// The street drive of simulate_scans: ground, box buildings, poles and parked cars along a car's
+// path.
+SweepDrive street_drive(const rig::Rig& rig, const SimConfig& config);
+// Sweeps along the trajectories part's path, sweep k starting at its pose k (the same stamps):
+// a courtyard of boxes of many sizes (kiosks, walls, buildings, poles) on a ground plane around
+// the path, none nearer than 2 m to it, drawn from the part's own random stream
+// ("trajectory-scans").
+SweepDrive trajectory_drive(const rig::Rig& rig, const SimConfig& config,
+                            const TrajectoryPart& part);
 struct Sweep {
   Time stamp;
   SE3 T_world_lidar;  // at the start of the sweep
   std::vector<LidarPoint> points;
 };
-// The next sweep of the drive (config.scans of them fit the world built; later ones leave it).
-Sweep next_sweep(StreetDrive& drive);
+// The next sweep of the drive (street_drive: config.scans of them fit the world built; later
+// ones leave it).
+Sweep next_sweep(SweepDrive& drive);
 
 StereoPart simulate_stereo(const rig::Rig& rig, const SimConfig& config);
 LidarCameraPart simulate_lidar_camera(const rig::Rig& rig, const SimConfig& config);

@@ -9,7 +9,7 @@
 namespace rigcal::sim {
 
 PoseSource pose_source(const Motion& motion) {
-  return [&motion](double t) { return evaluate(motion, t).T_world_base; };
+  return [motion](double t) { return evaluate(motion, t).T_world_base; };
 }
 
 std::pair<PoseSource, double> pose_source(const Trajectory& replay) {

@@ -14,9 +14,10 @@ namespace rigcal::sim {
 
 // T_world_base at motion time t (s).
 using PoseSource = std::function<SE3(double)>;
-PoseSource pose_source(const Motion& motion);
+PoseSource pose_source(const Motion& motion);  // holds a copy of the motion
 // Replays a trajectory (e.g. a VBR ground truth): motion time 0 is its first stamp; poses are
-// interpolated (slerp + linear). The second value is its duration in s.
+// interpolated (slerp + linear). The second value is its duration in s. The source refers to
+// `replay`, which must outlive it.
 std::pair<PoseSource, double> pose_source(const Trajectory& replay);
 
 struct OdometryNoise {

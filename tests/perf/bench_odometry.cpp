@@ -66,7 +66,7 @@ const rig::Rig& sample_rig() {
 const Drive& drive(int sensor) {
   static std::map<int, Drive> drives;
   if (!drives.count(sensor)) {
-    sim::StreetDrive street =
+    sim::SweepDrive street =
         sim::street_drive(sample_rig(), drive_config(sensor, g_smoke ? 5 : 30));
     Drive& d = drives[sensor];
     for (int k = 0; k < (g_smoke ? 5 : 30); ++k) {
@@ -149,7 +149,7 @@ double resident_mb() {
 void BM_RigcalOdometryLongDrive(benchmark::State& state) {
   const int scans = g_long_drive_scans;
   for (auto _ : state) {
-    sim::StreetDrive street = sim::street_drive(sample_rig(), drive_config(1, scans));
+    sim::SweepDrive street = sim::street_drive(sample_rig(), drive_config(1, scans));
     lidar::Odometry o = lidar::start_odometry(lidar::os1_64_car());
     std::vector<SE3> T_world_lidar;
     for (int k = 0; k < scans; ++k) {

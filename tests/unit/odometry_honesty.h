@@ -29,7 +29,7 @@ inline HonestyFigures odometry_honesty(const sim::LidarModel& sensor, const Odom
     config.seed = seed;
     config.scans = sweeps;
     config.lidar = sensor;
-    sim::StreetDrive street = sim::street_drive(rig, config);
+    sim::SweepDrive street = sim::street_drive(rig, config);
     Odometry odometry = start_odometry(preset);
     std::vector<SE3> T_world_lidar;
     std::printf("[ figures ] seed %d: step NEES", int(seed));

@@ -200,6 +200,79 @@ TEST(SimLidar, BoardPointsLieOnTheTruePlaneWithinTheRangeNoise) {
   }
 }
 
+// The sweep tests only the rectangles within range, nearest first, by azimuth sector: the same
+// points as casting every beam against every rectangle (the later rectangle winning ties), on a
+// courtyard along a walk and on the board's room, where ties decide which face a point is on.
+TEST(SimLidar, TheCulledSweepIsTheSweepOfEveryRectangle) {
+  const rig::Rig rig = rig::read_rig_file(RIGCAL_SOURCE_DIR "/data/sample_rig.yaml");
+  sim::SimConfig config;
+  config.trajectory_duration_s = 2;
+  config.trajectory_motion = sim::MotionKind::walk;
+  config.lidar.columns = 256;
+  const sim::TrajectoryPart part = sim::simulate_trajectories(rig, config);
+  const sim::SweepDrive drive = sim::trajectory_drive(rig, config, part);
+  // Every beam against every rectangle, in the scene's order: the reference.
+  auto reference = [](const sim::Scene& scene, const sim::LidarModel& m,
+                      const std::function<SE3(double)>& T_world_lidar, double t0) {
+    std::vector<std::pair<Eigen::Vector3f, int>> out;
+    for (int c = 0; c < m.columns; ++c) {
+      const SE3 T = T_world_lidar(t0 + c / (m.rate_hz * m.columns));
+      const double azimuth = 2.0 * M_PI * (1.0 - static_cast<double>(c) / m.columns);
+      for (int b = 0; b < m.beams; ++b) {
+        const double e =
+            (0.5 * m.vertical_fov_deg - m.vertical_fov_deg * b / std::max(1, m.beams - 1)) * M_PI /
+            180.0;
+        const Eigen::Vector3d d_lidar(std::cos(e) * std::cos(azimuth),
+                                      std::cos(e) * std::sin(azimuth), std::sin(e));
+        const Eigen::Vector3d d = T.R * d_lidar;
+        double best = m.max_range_m;
+        int hit = -1;
+        for (size_t i = 0; i < scene.rects.size(); ++i) {
+          const sim::Rect& r = scene.rects[i];
+          const Eigen::Vector3d n = r.u.cross(r.v);
+          if (std::abs(n.dot(d)) < 1e-12) continue;
+          const double s = n.dot(r.centre - T.t) / n.dot(d);
+          if (s < m.min_range_m || s > best) continue;
+          const Eigen::Vector3d q = T.t + s * d - r.centre;
+          if (std::abs(q.dot(r.u)) > r.half_u || std::abs(q.dot(r.v)) > r.half_v) continue;
+          best = s;
+          hit = int(i);
+        }
+        if (hit >= 0) out.push_back({(best * d_lidar).cast<float>(), hit});
+      }
+    }
+    return out;
+  };
+  auto check = [&](const sim::Scene& scene, const sim::LidarModel& m,
+                   const std::function<SE3(double)>& T_world_lidar, double t0) {
+    sim::LidarModel exact = m;
+    exact.range_noise_m = 0;
+    std::mt19937_64 rng(1);
+    const std::vector<sim::LidarPoint> culled = sim::sweep(scene, exact, T_world_lidar, t0, rng);
+    const auto all = reference(scene, exact, T_world_lidar, t0);
+    ASSERT_EQ(culled.size(), all.size());
+    ASSERT_GT(all.size(), 1000u);
+    size_t same = 0;
+    for (size_t i = 0; i < all.size(); ++i)
+      same += culled[i].p == all[i].first && culled[i].object == scene.rects[all[i].second].id;
+    EXPECT_EQ(same, all.size());
+  };
+  check(drive.scene, drive.lidar, drive.T_world_lidar, 0.5);
+  // The board's room: its front face wins the tie with its box's front face.
+  sim::SimConfig board_config;
+  board_config.lidar.columns = 256;
+  sim::Scene room;
+  sim::add_room(room, 4, 5, -1.2, 2.2);
+  const camera::Target target = sim::default_target();
+  const camera::Pattern pattern(target);
+  SE3 T_world_board;
+  T_world_board.R = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  T_world_board.t = Eigen::Vector3d(2.0, -0.2, 0.0);
+  sim::add_board(room, target, pattern, T_world_board, -1.2, 1);
+  check(
+      room, board_config.lidar, [](double) { return SE3(); }, 0.0);
+}
+
 TEST(SimImu, SignalsIntegrateBackToTheTrueMotion) {
   std::mt19937_64 rng(5);
   const Motion motion = random_motion(MotionKind::handheld, 12.0, rng);
