@@ -18,7 +18,7 @@ namespace {
 struct Options {
   std::string recording, out, covariances, report, sensor = "os0-128";
   std::optional<double> voxel_size_m, min_range_m, max_range_m;
-  bool no_deskew = false;
+  bool no_deskew = false, sweep_motion = false;
 };
 
 void run(const Options& o) {
@@ -27,6 +27,7 @@ void run(const Options& o) {
   if (o.min_range_m) config.min_range_m = *o.min_range_m;
   if (o.max_range_m) config.max_range_m = *o.max_range_m;
   config.deskew = !o.no_deskew;
+  config.estimate_sweep_motion = o.sweep_motion;
   const std::string covariances =
       o.covariances.empty()
           ? (std::filesystem::path(o.out).replace_extension("").string() + "_covariances.txt")
@@ -86,6 +87,9 @@ void add_odometry(CLI::App& app) {
   cmd->add_option("--max-range", o->max_range_m, "points farther than this are dropped, m")
       ->check(finite_number(false) & CLI::PositiveNumber);
   cmd->add_flag("--no-deskew", o->no_deskew, "register the points as measured");
+  cmd->add_flag("--sweep-motion", o->sweep_motion,
+                "estimate each sweep's own motion with its pose (continuous time, 12 parameters) "
+                "instead of taking the step before it: for a walker's bob and sway");
   cmd->callback([o] { run(*o); });
 }
 

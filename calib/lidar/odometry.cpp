@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <Eigen/Eigenvalues>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 
@@ -55,6 +56,17 @@ OdometryConfig odometry_preset(const std::string& name) {
   if (name == "os0-128") return os0_128_handheld();
   if (name == "os1-64") return os1_64_car();
   throw Error(fmt::format("unknown sensor preset '{}' (os0-128 or os1-64)", name));
+}
+
+std::string preset_for_model(std::string_view model) {
+  std::string m;
+  for (char c : model) {
+    if (std::isalnum(static_cast<unsigned char>(c)))
+      m += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  }
+  if (m.find("os0") != std::string::npos) return "os0-128";
+  if (m.find("os1") != std::string::npos) return "os1-64";
+  return "";
 }
 
 Odometry start_odometry(const OdometryConfig& config) {
@@ -130,7 +142,9 @@ Step register_scan(Odometry& o, const Scan& scan) {
       step.seconds = seconds_since(started);
       return step;
     }
-    for (int pass = 1; deskew && pass < c.deskew_passes && r.correspondences >= 6; ++pass)
+    const bool sweep_motion = deskew && c.estimate_sweep_motion;
+    for (int pass = 1; deskew && !sweep_motion && pass < c.deskew_passes && r.correspondences >= 6;
+         ++pass)
       r = registered(r.T_odom_lidar, T_odom_prev.inverse() * r.T_odom_lidar);
     // The second scan: the first one deskewed with the motion now known, the map rebuilt from
     // it, and the second registered again (twice: the motion improves with the map).
@@ -140,6 +154,20 @@ Step register_scan(Odometry& o, const Scan& scan) {
       r = registered(r.T_odom_lidar, r.T_odom_lidar);
     }
     if (n == 1) o.first_scan = Scan{};
+    if (sweep_motion) {
+      // The sweep's own motion, about the last step's.
+      const SE3 T_prev_cur = T_odom_prev.inverse() * r.T_odom_lidar;
+      const double deg = c.sweep_motion_sigma_deg * M_PI / 180.0, m = c.sweep_motion_sigma_m;
+      const SweepRegistration s =
+          register_sweep(source_raw, period_s, o.map, r.T_odom_lidar, T_prev_cur,
+                         (Vector6d() << deg, deg, deg, m, m, m).finished(), 3.0 * sigma,
+                         sigma / 3.0, c.registration);
+      if (s.start.correspondences >= 12 && s.start.converged) {
+        r = s.start;
+        frame = deskewed(frame_raw, s.T_start_end);
+        source = deskewed(source_raw, s.T_start_end);
+      }
+    }
     step.points_used = source.size();
     T_odom_cur = r.T_odom_lidar;
     update(o.threshold, T_odom_predicted.inverse() * T_odom_cur);

@@ -4,6 +4,7 @@
 // degeneracy of every step. Each pose is the sensor's at the scan's stamp (the sweep's first
 // point, Scan::stamp), the convention of VBR's ground truth.
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "rigcal/core/scan.h"
@@ -22,6 +23,11 @@ struct OdometryConfig {
   double initial_threshold_m = 2.0, min_motion_m = 0.1;
   bool deskew = true;
   int deskew_passes = 2;  // 2: deskew again with the estimated motion and refine
+  // Estimate each sweep's own motion with its pose (register_sweep) instead of taking the motion
+  // of the step before it, with a prior about that step's motion of these sigmas (per axis, over
+  // the sweep).
+  bool estimate_sweep_motion = false;
+  double sweep_motion_sigma_deg = 1.0, sweep_motion_sigma_m = 0.05;
   RegistrationConfig registration;
   // A step is called degenerate when the information's weakest direction holds less than this
   // fraction of its strongest (translation and rotation blocks separately).
@@ -41,6 +47,9 @@ OdometryConfig os0_128_handheld();  // 10 Hz, indoor and outdoor on foot: 0.5 m 
 OdometryConfig os1_64_car();        // 20 Hz, streets: 1.0 m voxels, 100 m
 // "os0-128" | "os1-64"; throws rigcal::Error naming the choices otherwise.
 OdometryConfig odometry_preset(const std::string& name);
+// The preset for a rig's LiDAR `model` ("OS0-128", "Ouster OS1-64", ...): "os0-128" for an OS0,
+// "os1-64" for an OS1, "" for a model neither names.
+std::string preset_for_model(std::string_view model);
 
 // How well a step's registration constrains each direction: from its relative covariance, the
 // largest translation and rotation sigmas and their directions, and the information's weakest

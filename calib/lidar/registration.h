@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "rigcal/core/scan.h"
 #include "rigcal/core/se3.h"
 #include "rigcal/lidar/voxel_map.h"
 
@@ -47,5 +48,24 @@ struct Registration {
 Registration register_points(const std::vector<Eigen::Vector3d>& points_lidar, const VoxelMap& map,
                              const SE3& T_odom_lidar_guess, double max_correspondence_m,
                              double kernel_m, const RegistrationConfig& config);
+
+// The continuous-time form: the sweep's own motion over its period estimated with its start
+// pose, each point placed by its time (motion_fraction of the motion, as the deskew does), so that
+// a motion that changes from one sweep to the next (a walker's bob and sway) is followed rather
+// than lagged by one sweep. r_i = n_i . (T_odom_start M(f_i) p_i - m_i), f_i = t_i / period,
+// 12 parameters, a Gaussian prior on the motion (its sigmas per rotation and translation axis
+// over the sweep, rad and m) about `T_start_end_prior`.
+struct SweepRegistration {
+  // The start pose (T_odom_lidar at the sweep's stamp): its information and covariance with the
+  // motion marginalised.
+  Registration start;
+  SE3 T_start_end;                                // the sensor's motion over the period
+  Matrix6d motion_covariance = Matrix6d::Zero();  // of T_start_end, rigcal's tangent
+};
+SweepRegistration register_sweep(const std::vector<ScanPoint>& points, double period_s,
+                                 const VoxelMap& map, const SE3& T_odom_start_guess,
+                                 const SE3& T_start_end_prior, const Vector6d& prior_sigma,
+                                 double max_correspondence_m, double kernel_m,
+                                 const RegistrationConfig& config);
 
 }  // namespace rigcal::lidar
