@@ -101,7 +101,8 @@ void add_calibrate(CLI::App& app) {
       "calibrate",
       "Calibrate a whole session in one run (doc/session.md): cameras (stereo/), LiDAR-camera\n"
       "(lidar_camera/, the right camera), the IMU clock offsets (motion/), hand-eye GNSS/INS to\n"
-      "LiDAR with the clock offset (motion/ with --odometry). Writes OUT/calib.yaml once,\n"
+      "LiDAR with the clock offset (motion/: rigcal's own odometry on its ouster_points/, or\n"
+      "--odometry FILE). Writes OUT/calib.yaml once,\n"
       "atomically, with rigcal.steps (inputs and their sha256, tool version, sigmas, residuals),\n"
       "and OUT/reports/<step>/. A rerun reuses each step whose inputs, rig entries and options\n"
       "are unchanged (OUT/cache/). Exit 0 every step that ran is ok (published when all ran);\n"
@@ -118,7 +119,11 @@ void add_calibrate(CLI::App& app) {
   cmd->add_option("--target", o->target,
                   "target YAML (default: session.yaml's target, or SESSION/target.yaml)");
   cmd->add_option("--odometry", o->odometry,
-                  "the motion recording's LiDAR odometry, T_odom_lidar (TUM, KITTI, EuRoC)");
+                  "the motion recording's LiDAR odometry, T_odom_lidar (TUM, KITTI, EuRoC); "
+                  "default: rigcal's own on the motion recording's ouster_points/");
+  cmd->add_option("--odometry-preset", o->run.hand_eye.odometry_preset,
+                  "rigcal's odometry preset: os0-128 | os1-64 (default: the rig LiDAR's model)")
+      ->check(CLI::IsMember({"os0-128", "os1-64"}));
   cmd->add_option("--gnss", o->gnss,
                   "the GNSS/INS trajectory or fixes (default: motion/gnss/poses.tum or fixes.csv)");
   cmd->add_option("--attitude", o->run.hand_eye.attitude, "GNSS fixes only: enu | ned")

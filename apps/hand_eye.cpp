@@ -9,13 +9,15 @@
 #include "rigcal/core/text.h"
 #include "rigcal/hand_eye/step.h"
 #include "rigcal/io/session.h"
+#include "rigcal/lidar/step.h"
 #include "step_output.h"
 
 namespace rigcal::cli {
 namespace {
 
 struct Options {
-  std::string lidar, gnss, session, sensor = "gnss", lidar_sensor = "lidar", rig, out, report;
+  std::string lidar, scans, odometry_preset, gnss, session, sensor = "gnss", lidar_sensor = "lidar",
+                                                            rig, out, report;
   std::string duplicates = "error", attitude;
   std::vector<std::string> fix;    // AXIS=VALUE, GNSS/INS frame
   std::vector<std::string> prior;  // AXIS=VALUE,SIGMA
@@ -45,17 +47,22 @@ void run(const Options& o) {
   so.max_sigma_m = o.max_sigma_m;
   so.estimate_offset = o.estimate_offset;
   hand_eye::StepInputs in;
+  so.odometry_preset = o.odometry_preset;
   in.lidar = o.lidar, in.gnss = o.gnss, in.rig_source = o.rig;
+  if (!o.lidar.empty() && !o.scans.empty()) throw Error("give --lidar or --scans, not both");
+  if (!o.scans.empty()) in.lidar_scans = lidar::scans_folder(o.scans, console_progress());
   if (!o.session.empty()) {  // what the session names, unless given
     const io::Session s = io::read_session(o.session, console_progress());
-    if (in.lidar.empty()) in.lidar = s.odometry;
+    if (in.lidar.empty() && in.lidar_scans.empty()) in.lidar = s.odometry;
     if (in.gnss.empty()) in.gnss = s.gnss;
   }
-  if (in.lidar.empty() || in.gnss.empty())
+  if ((in.lidar.empty() && in.lidar_scans.empty()) || in.gnss.empty())
     throw Error(
-        "give --lidar and --gnss, or a --session whose session.yaml names odometry and gnss");
-  io::refuse_outputs_over_inputs(
-      {{o.out, ""}}, {{"--lidar", in.lidar}, {"--gnss", in.gnss}});  // --rig may be --out
+        "give --lidar (or --scans) and --gnss, or a --session whose session.yaml names "
+        "odometry and gnss");
+  io::refuse_outputs_over_inputs({{o.out, ""}}, {{"--lidar", in.lidar},
+                                                 {"--scans", in.lidar_scans},
+                                                 {"--gnss", in.gnss}});  // --rig may be --out
   if (!o.rig.empty()) in.rig = rig::read_rig_file(o.rig);
   const report::StepResult r = hand_eye::estimate_extrinsic(in, so, console_progress());
   finish_step(r, o.out, o.report);
@@ -76,6 +83,12 @@ void add_hand_eye(CLI::App& app) {
       "so). Inputs: TUM, KITTI with times, EuRoC. Exit 0; 2 on bad input, 3 when a\n"
       "direction is undetermined and nothing fixes it: nothing written in either case.");
   cmd->add_option("--lidar", o->lidar, "LiDAR odometry trajectory (T_odom_lidar)");
+  cmd->add_option("--scans", o->scans,
+                  "or the LiDAR's scans (as `rigcal odometry` takes them): rigcal's odometry "
+                  "runs first; its trajectory joins the report");
+  cmd->add_option("--odometry-preset", o->odometry_preset,
+                  "with --scans: os0-128 | os1-64 (default: the rig LiDAR's model)")
+      ->check(CLI::IsMember({"os0-128", "os1-64"}));
   cmd->add_option("--gnss", o->gnss,
                   "GNSS/INS trajectory (T_enu_gnss; TUM, KITTI, EuRoC, OpenCalib), or a CSV of "
                   "fixes with a header (time, latitude, longitude, height, roll, pitch, yaw), on "

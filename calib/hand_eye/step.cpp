@@ -12,6 +12,8 @@
 #include "rigcal/core/version.h"
 #include "rigcal/hand_eye/report.h"
 #include "rigcal/io/gnss_fixes.h"
+#include "rigcal/io/odometry_io.h"
+#include "rigcal/lidar/step.h"
 #include "rigcal/report/json.h"
 
 namespace rigcal::hand_eye {
@@ -42,6 +44,13 @@ Trajectory read_gnss(const StepInputs& in, const StepOptions& o,
   return fixes.T_enu_gnss;
 }
 
+// What the LiDAR's trajectory came from, for the report.
+std::string lidar_name(const StepInputs& in) {
+  return in.lidar_scans.empty()
+             ? in.lidar.string()
+             : fmt::format("lidar_odometry.tum (rigcal's odometry on {})", in.lidar_scans.string());
+}
+
 // No estimate: the report says why, with the inputs and the notes so far.
 report::StepResult undetermined(report::StepResult out, const StepInputs& in, std::string reason,
                                 std::string remedy) {
@@ -50,8 +59,7 @@ report::StepResult undetermined(report::StepResult out, const StepInputs& in, st
   out.remedy = std::move(remedy);
   const nlohmann::json j = {
       {"tool_version", version_string()},
-      {"inputs",
-       {{"lidar", in.lidar.string()}, {"gnss", in.gnss.string()}, {"rig", in.rig_source}}},
+      {"inputs", {{"lidar", lidar_name(in)}, {"gnss", in.gnss.string()}, {"rig", in.rig_source}}},
       {"notes", out.notes}};
   out.report_files = {{"hand_eye.json", report::json_text(j)}};
   report::finish_report(out, "hand_eye.json");
@@ -91,11 +99,12 @@ std::vector<RefineOptions::Fixed> parse_translation_constraints(
   return out;
 }
 
-report::StepResult estimate_extrinsic(const StepInputs& in, const StepOptions& o,
-                                      const report::Progress& progress) {
-  report::StepResult out;
+namespace {
+
+// The estimate from the LiDAR's trajectory `lidar` (read from in.lidar or made from its scans).
+report::StepResult estimate(const StepInputs& in, const StepOptions& o, const Trajectory& lidar,
+                            report::StepResult out, const report::Progress& progress) {
   out.step = "hand_eye";
-  out.inputs = {{"lidar odometry", in.lidar}, {"gnss", in.gnss}};
   double offset_s = 0.0;
   SE3 T_base_lidar;
   std::optional<SE3> prior_T_gnss_lidar;
@@ -113,12 +122,10 @@ report::StepResult estimate_extrinsic(const StepInputs& in, const StepOptions& o
   }
   io::TrajectoryReadOptions read;
   read.duplicates = o.duplicates;
-  report::tell(progress, "reading the trajectories", 0, 2);
-  const Trajectory lidar = io::read_trajectory(in.lidar, read).trajectory;
-  report::tell(progress, "reading the trajectories", 1, 2);
   std::vector<std::string>& notes = out.notes;
+  report::tell(progress, "reading the GNSS/INS trajectory", 0, 1);
   const Trajectory gnss = read_gnss(in, o, read, notes);
-  report::tell(progress, "reading the trajectories", 2, 2);
+  report::tell(progress, "reading the GNSS/INS trajectory", 1, 1);
   if (lidar.size() < 2 || gnss.size() < 2) throw Error("each trajectory needs at least 2 poses");
 
   // The clock offset from the two trajectories' angular velocities (doc/time-offset.md), around
@@ -189,7 +196,7 @@ report::StepResult estimate_extrinsic(const StepInputs& in, const StepOptions& o
         "intervals (median of {} motion pairs; a rigid mount turns both alike): a static or "
         "foreign odometry, or clocks apart by more than the pairs' length (the rig's time_offset, "
         "--estimate-offset)",
-        in.lidar.string(), in.gnss.string(), angle_ratio, pairs.size()));
+        lidar_name(in), in.gnss.string(), angle_ratio, pairs.size()));
   }
   const ClosedForm cf = closed_form(pairs, o.max_sigma_m);
   const Observability& ob = cf.observability;
@@ -299,8 +306,8 @@ report::StepResult estimate_extrinsic(const StepInputs& in, const StepOptions& o
       fmt::format("odometry scale {:.5f} ± {:.5f} (GNSS/INS distance over LiDAR distance)",
                   r.odometry_scale, r.odometry_scale_sigma));
 
-  HandEyeInputs rin{in.lidar.string(), in.gnss.string(),    in.rig_source, offset_s, spacings,
-                    po.stride_s,       po.min_rotation_deg, o.max_sigma_m, notes};
+  HandEyeInputs rin{lidar_name(in), in.gnss.string(),    in.rig_source, offset_s, spacings,
+                    po.stride_s,    po.min_rotation_deg, o.max_sigma_m, notes};
   out.report_files = hand_eye_report_files("", rin, pairs, cf, r, lidar, gnss);
   report::finish_report(out, "hand_eye.json");
 
@@ -330,6 +337,53 @@ report::StepResult estimate_extrinsic(const StepInputs& in, const StepOptions& o
                    {"outlier_pairs", static_cast<double>(outliers), ""},
                    {"noise_scale", r.noise_scale, ""},
                    {"odometry_scale", r.odometry_scale, ""}};
+  return out;
+}
+
+}  // namespace
+
+report::StepResult estimate_extrinsic(const StepInputs& in, const StepOptions& o,
+                                      const report::Progress& progress) {
+  report::StepResult out;
+  if (in.lidar_scans.empty()) {
+    out.inputs = {{"lidar odometry", in.lidar}, {"gnss", in.gnss}};
+    io::TrajectoryReadOptions read;
+    read.duplicates = o.duplicates;
+    report::tell(progress, "reading the LiDAR odometry", 0, 1);
+    const Trajectory lidar = io::read_trajectory(in.lidar, read).trajectory;
+    report::tell(progress, "reading the LiDAR odometry", 1, 1);
+    return estimate(in, o, lidar, std::move(out), progress);
+  }
+  // rigcal's own odometry on the scans, with the preset the rig's LiDAR names.
+  out.inputs = {{"lidar scans", in.lidar_scans}, {"gnss", in.gnss}};
+  std::string preset = o.odometry_preset;
+  if (preset.empty() && in.rig) {
+    if (const rig::Sensor* l = rig::find_sensor(*in.rig, o.lidar_sensor)) {
+      preset = lidar::preset_for_model(l->model);
+      if (preset.empty() && !l->model.empty()) {
+        out.notes.push_back(
+            fmt::format("odometry: the LiDAR's model '{}' names no preset; os0-128's is used (give "
+                        "--odometry-preset)",
+                        l->model));
+      }
+    }
+  }
+  if (preset.empty()) preset = "os0-128";
+  const lidar::OdometryRun run =
+      lidar::run_odometry(in.lidar_scans, lidar::odometry_preset(preset), progress);
+  const nlohmann::json odometry = lidar::odometry_report(run);
+  const nlohmann::json& s = odometry["summary"];
+  out.summary.push_back(fmt::format(
+      "LiDAR odometry (rigcal's, preset {}): {} scans registered of {}, path {:.2f} m, {:.1f} ms a "
+      "scan, {} degenerate steps (odometry.json)",
+      preset, run.T_odom_lidar.size(), run.steps.size(), s["path_length_m"].get<double>(),
+      1e3 * s["registration_seconds_mean"].get<double>(), s["degenerate_steps"].get<size_t>()));
+  for (const std::string& n : run.notes) out.notes.push_back("odometry: " + n);
+  out = estimate(in, o, run.T_odom_lidar, std::move(out), progress);
+  out.report_files.push_back({"lidar_odometry.tum", io::trajectory_to_tum(run.T_odom_lidar)});
+  out.report_files.push_back({"lidar_odometry_covariances.txt",
+                              io::step_covariances_to_text(lidar::step_covariances(run))});
+  out.report_files.push_back({"odometry.json", odometry.dump(1) + "\n"});
   return out;
 }
 

@@ -23,10 +23,17 @@ struct StepOptions {
   // Estimate the clock offset from the trajectories' angular velocities and write it. When not,
   // the estimate is still made and a disagreement with the rig's value is reported.
   bool estimate_offset = false;
+  // rigcal's odometry on StepInputs::lidar_scans: a lidar::odometry_preset name, or "" for the
+  // one the rig's LiDAR model names (lidar::preset_for_model), else os0-128.
+  std::string odometry_preset;
 };
 
 struct StepInputs {
   std::filesystem::path lidar;  // T_odom_lidar
+  // Or, with `lidar` empty, the LiDAR's scans (a folder or a capture, as lidar::scans_folder
+  // gives): rigcal's odometry runs on them first; its trajectory (lidar_odometry.tum), step
+  // covariances and odometry.json join the report beside hand_eye.json.
+  std::filesystem::path lidar_scans;
   std::filesystem::path gnss;   // T_enu_gnss, or a CSV of fixes
   std::optional<rig::Rig> rig;  // clock offsets and the prior extrinsic; none: estimate only
   std::string rig_source;       // where the rig came from, for the report

@@ -287,15 +287,26 @@ std::vector<Plan> make_plans(const CalibrateOptions& o, const io::Session& s,
     p.step = "hand_eye";
     const fs::path odometry = o.odometry.empty() ? s.odometry : o.odometry;
     const fs::path gnss = o.gnss.empty() ? s.gnss : o.gnss;
-    if (odometry.empty())
+    // No odometry named: rigcal's own on the motion recording's scans.
+    fs::path scans;
+    if (odometry.empty()) {
+      try {
+        const fs::path rec = io::recording_for(s, "motion");
+        if (fs::is_directory(rec / "ouster_points")) scans = rec / "ouster_points";
+      } catch (const Error&) {
+      }
+    }
+    if (odometry.empty() && scans.empty())
       p.cannot_plan =
-          "no LiDAR odometry: give --odometry FILE.tum (T_odom_lidar) or name it in session.yaml "
-          "(odometry: FILE)";
+          "no LiDAR odometry: the motion recording has no ouster_points/ for rigcal's own "
+          "odometry; record the LiDAR during the motion, or give --odometry FILE.tum "
+          "(T_odom_lidar) or name it in session.yaml (odometry: FILE)";
     else if (gnss.empty())
       p.cannot_plan =
           "no GNSS/INS trajectory: give --gnss FILE, put it in the motion recording as "
           "gnss/poses.tum or gnss/fixes.csv, or name it in session.yaml (gnss: FILE)";
     if (!odometry.empty()) p.inputs.emplace_back("lidar odometry", odometry);
+    if (!scans.empty()) p.inputs.emplace_back("lidar scans", scans);
     if (!gnss.empty()) p.inputs.emplace_back("gnss", gnss);
     const hand_eye::StepOptions& h = o.hand_eye;
     p.reads = {h.sensor, h.lidar_sensor};
@@ -306,14 +317,16 @@ std::vector<Plan> make_plans(const CalibrateOptions& o, const io::Session& s,
     p.options = fmt::format(
         "sensor {} lidar {} attitude {} spacings {} stride {} min_rotation {} smoothing {} "
         "rotation_sigma {} translation_sigma {} max_sigma {} estimate_offset {} fixed {} "
-        "duplicates {} max_gap {} huber {} estimate_scale {}",
+        "duplicates {} max_gap {} huber {} estimate_scale {} odometry_preset {}",
         h.sensor, h.lidar_sensor, h.attitude, fmt::join(h.pairs.spacings_s, ","), h.pairs.stride_s,
         h.pairs.min_rotation_deg, h.pairs.gnss_half_window_s, h.refine.rotation_sigma_deg,
         h.refine.translation_sigma_m, h.max_sigma_m, h.estimate_offset, fixed,
-        static_cast<int>(h.duplicates), h.pairs.max_gap_s, h.refine.huber, h.refine.estimate_scale);
-    p.run = [odometry, gnss, h](const rig::Rig& rig, const report::Progress& pr) {
+        static_cast<int>(h.duplicates), h.pairs.max_gap_s, h.refine.huber, h.refine.estimate_scale,
+        h.odometry_preset.empty() ? "rig" : h.odometry_preset);
+    p.run = [odometry, scans, gnss, h](const rig::Rig& rig, const report::Progress& pr) {
       hand_eye::StepInputs in;
       in.lidar = odometry;
+      in.lidar_scans = scans;
       in.gnss = gnss;
       in.rig = rig;
       in.rig_source = "the session's rig";

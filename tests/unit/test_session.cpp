@@ -29,6 +29,7 @@
 #include "rigcal/io/image_sets.h"
 #include "rigcal/io/rates_io.h"
 #include "rigcal/io/session.h"
+#include "rigcal/io/trajectory_io.h"
 #include "rigcal/rig/rig_yaml.h"
 #include "rigcal/session/provenance.h"
 #include "rigcal/session/publish.h"
@@ -104,6 +105,7 @@ fs::path simulate_devkit_session(const fs::path& dir, const std::string& what,
     if (fs::exists(root / cam)) devkit_images(root / cam);
   }
   if (fs::exists(root / "lidar_camera")) devkit_points(root / "lidar_camera" / "ouster_points");
+  if (fs::exists(root / "ouster_points")) devkit_points(root / "ouster_points");
   if (fs::exists(root / "imu")) {
     devkit_imu(root / "imu");
     devkit_imu(root / "ouster_imu");
@@ -454,6 +456,74 @@ TEST_F(Session, OnlyFromAndAnUndeterminedStep) {
   EXPECT_NE(u.out.find("what would settle it: record the two IMUs"), std::string::npos) << u.out;
 }
 
+// No odometry file: hand-eye runs rigcal's own odometry on the motion recording's sweeps (the
+// devkit's layout, a 30 s walk through a courtyard, OS0-128 at 1024 columns) and estimates from
+// it what `rigcal hand-eye` estimates from the trajectory it writes. The accuracy bars are the
+// levels measured (doc/odometry.md: a walker's bob within a sweep is what the constant-velocity
+// deskew misses, and hand-eye inherits it), to catch a regression, not a claim of accuracy.
+TEST_F(Session, HandEyeRunsRigcalsOdometryOnTheMotionScans) {
+  const fs::path session = simulate_devkit_session(
+      dir_, "trajectories",
+      "trajectories:\n  duration_s: 30\n  motion: walk\n  scans: true\nlidar:\n  columns: 1024\n");
+  EXPECT_EQ(slurp(session / "session.yaml").find("odometry:"), std::string::npos);
+  const fs::path out = dir_ / "calibration";
+  const CliRun he = rigcal_cli(fmt::format("calibrate {} --out {} --rig {} --only hand_eye",
+                                           session.string(), out.string(), kPrior),
+                               dir_);
+  ASSERT_EQ(he.status, 0) << he.out << he.err;
+  EXPECT_NE(he.out.find("== hand_eye: ok"), std::string::npos) << he.out;
+  EXPECT_NE(he.out.find("LiDAR odometry (rigcal's, preset os0-128): 301 scans registered of 301"),
+            std::string::npos)
+      << he.out;
+  const fs::path report = out / "reports" / "hand_eye";
+  for (const char* f :
+       {"hand_eye.json", "lidar_odometry.tum", "lidar_odometry_covariances.txt", "odometry.json"})
+    EXPECT_TRUE(fs::exists(report / f)) << f;
+  const nlohmann::json j = nlohmann::json::parse(slurp(report / "hand_eye.json"));
+  EXPECT_NE(j["inputs"]["lidar"].get<std::string>().find("rigcal's odometry on"),
+            std::string::npos);
+  auto T_gnss_lidar = [](const nlohmann::json& r) {
+    Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 4; ++b) m(a, b) = r["T_gnss_lidar"]["matrix"][a][b].get<double>();
+    return SE3::from_matrix(m);
+  };
+  // The same estimate from the written trajectory through `rigcal hand-eye`.
+  const CliRun alone =
+      rigcal_cli(fmt::format("hand-eye --lidar {} --gnss {} --rig {} --estimate-offset --report {}",
+                             (report / "lidar_odometry.tum").string(),
+                             (session / "trajectories" / "gnss_ins.tum").string(), kPrior,
+                             (dir_ / "alone").string()),
+                 dir_);
+  ASSERT_EQ(alone.status, 0) << alone.err;
+  const SE3 e = T_gnss_lidar(j);
+  const SE3 e_alone = T_gnss_lidar(nlohmann::json::parse(slurp(dir_ / "alone" / "hand_eye.json")));
+  EXPECT_LT((e.t - e_alone.t).norm(), 1e-9);
+  EXPECT_LT(rotation_error_deg(e, e_alone), 1e-7);
+  // The odometry's steps against the truth, and the extrinsic: the measured levels.
+  const Trajectory odom = io::read_trajectory(report / "lidar_odometry.tum").trajectory;
+  const Trajectory truth =
+      io::read_trajectory(session / "trajectories" / "truth_lidar.tum").trajectory;
+  ASSERT_EQ(odom.size(), truth.size());
+  Eigen::Vector3d sq = Eigen::Vector3d::Zero();
+  for (size_t k = 1; k < truth.size(); ++k) {
+    const SE3 d = (truth.T_world_body[k - 1].inverse() * truth.T_world_body[k]).inverse() *
+                  (odom.T_world_body[k - 1].inverse() * odom.T_world_body[k]);
+    sq += d.t.cwiseAbs2();
+  }
+  const Eigen::Vector3d step_rms = (sq / double(truth.size() - 1)).cwiseSqrt();
+  EXPECT_LT(step_rms.head<2>().maxCoeff(), 0.005);
+  EXPECT_LT(step_rms.z(), 0.02);
+  const SE3 t = rig::T_a_b(rig::read_rig_file(kTruth), "gnss", "lidar");
+  EXPECT_LT(rotation_error_deg(e, t), 0.6);
+  EXPECT_LT((e.t - t.t).norm(), 0.15);
+  std::printf(
+      "[ figures ] walk, rigcal's odometry: step error rms %.1f %.1f %.1f mm (x y z); "
+      "T_gnss_lidar error %.3f deg, [%.1f %.1f %.1f] mm\n",
+      1e3 * step_rms.x(), 1e3 * step_rms.y(), 1e3 * step_rms.z(), rotation_error_deg(e, t),
+      1e3 * (e.t - t.t).x(), 1e3 * (e.t - t.t).y(), 1e3 * (e.t - t.t).z());
+}
+
 // A recording in the devkit layout as the messages the rig's drivers publish, under the topic
 // names vbr-devkit maps back to the same folders: images as stored (bgr8, mono8 or mono16), the
 // Ouster driver's point records, the gyro logs.
@@ -485,11 +555,16 @@ testing::bag::Recording recording_messages(const fs::path& recording) {
       const io::StampedFolder s = io::read_stamped_folder(d, ".png");
       for (size_t k = 0; k < s.files.size(); ++k) {
         const cv::Mat img = cv::imread(s.files[k], cv::IMREAD_UNCHANGED);
-        if (img.empty() || !img.isContinuous()) throw std::runtime_error("cannot read " + s.files[k]);
-        const std::string encoding = img.channels() == 3      ? "bgr8"
+        if (img.empty() || !img.isContinuous())
+          throw std::runtime_error("cannot read " + s.files[k]);
+        const std::string encoding = img.channels() == 3     ? "bgr8"
                                      : img.depth() == CV_16U ? "mono16"
-                                                              : "mono8";
-        r.images.push_back({topic, s.stamps[k].ns, img.cols, img.rows, encoding,
+                                                             : "mono8";
+        r.images.push_back({topic,
+                            s.stamps[k].ns,
+                            img.cols,
+                            img.rows,
+                            encoding,
                             {img.data, img.data + img.total() * img.elemSize()}});
       }
     }
@@ -522,17 +597,16 @@ TEST_F(Session, CalibrateOnBagsIsCalibrateOnTheirConversionAndOnTheFolders) {
     ASSERT_FALSE(messages.images.empty() && messages.clouds.empty() && messages.imus.empty())
         << rec;
     testing::bag::write_split_bags((bags / rec / rec).string(), messages);
-    const CliRun c = rigcal_cli(
-        fmt::format("convert {0}/{1}_0.bag {0}/{1}_1.bag --out {2}", (bags / rec).string(), rec,
-                    (converted / rec).string()),
-        dir_);
+    const CliRun c = rigcal_cli(fmt::format("convert {0}/{1}_0.bag {0}/{1}_1.bag --out {2}",
+                                            (bags / rec).string(), rec, (converted / rec).string()),
+                                dir_);
     ASSERT_EQ(c.status, 0) << c.out << c.err;
   }
   auto calibrate = [&](const fs::path& session, const std::string& name) {
     const fs::path out = dir_ / ("out_" + name);
     const CliRun r = rigcal_cli(
-        fmt::format("calibrate {} --out {} --rig {}", session.string(), out.string(), kPrior),
-        dir_, fmt::format("TMPDIR={}", tmp.string()));
+        fmt::format("calibrate {} --out {} --rig {}", session.string(), out.string(), kPrior), dir_,
+        fmt::format("TMPDIR={}", tmp.string()));
     EXPECT_EQ(r.status, 0) << name << "\n" << r.out << r.err;
     std::printf("[ figures ] calibrate on the %s: %.1f s\n", name.c_str(), r.seconds);
     return slurp(out / "calib.yaml");
@@ -547,8 +621,9 @@ TEST_F(Session, CalibrateOnBagsIsCalibrateOnTheirConversionAndOnTheFolders) {
   EXPECT_EQ(values(on_bags), values(on_conversion));
   EXPECT_EQ(values(on_bags), values(on_original));
   // The inputs as the user knows them: the folder of bags and the topic in it, not $TMPDIR.
-  for (const fs::path& p : {bags / "stereo" / "camera_left", bags / "lidar_camera" / "ouster_points",
-                            bags / "motion" / "ouster_imu"})
+  for (const fs::path& p :
+       {bags / "stereo" / "camera_left", bags / "lidar_camera" / "ouster_points",
+        bags / "motion" / "ouster_imu"})
     EXPECT_NE(on_bags.find("path: " + p.string() + ","), std::string::npos) << p << "\n" << on_bags;
   EXPECT_EQ(on_bags.find(tmp.string()), std::string::npos) << on_bags;
 }
