@@ -19,7 +19,7 @@ struct Options {
   session::CalibrateOptions run;
   std::string rig, target, odometry, gnss, out, bayer;
   std::vector<std::string> fix, prior;  // hand-eye's
-  bool no_estimate_offset = false;
+  bool no_estimate_offset = false, no_sweep_motion = false;
 };
 
 // The summary table: one row a step, then each step's reason where it did not end ok.
@@ -47,6 +47,7 @@ void run(Options o) {
   o.run.out = o.out;
   o.run.cameras.bayer = o.run.lidar_camera.bayer = io::bayer_from_string(o.bayer);
   o.run.hand_eye.estimate_offset = !o.no_estimate_offset;
+  o.run.hand_eye.odometry_sweep_motion = !o.no_sweep_motion;
   o.run.hand_eye.refine.fixed = hand_eye::parse_translation_constraints(o.fix, false);
   for (const auto& p : hand_eye::parse_translation_constraints(o.prior, true))
     o.run.hand_eye.refine.fixed.push_back(p);
@@ -124,6 +125,9 @@ void add_calibrate(CLI::App& app) {
   cmd->add_option("--odometry-preset", o->run.hand_eye.odometry_preset,
                   "rigcal's odometry preset: os0-128 | os1-64 (default: the rig LiDAR's model)")
       ->check(CLI::IsMember({"os0-128", "os1-64"}));
+  cmd->add_flag("--no-sweep-motion", o->no_sweep_motion,
+                "rigcal's odometry takes each sweep's motion from the step before instead of "
+                "estimating it (doc/odometry.md)");
   cmd->add_option("--gnss", o->gnss,
                   "the GNSS/INS trajectory or fixes (default: motion/gnss/poses.tum or fixes.csv)");
   cmd->add_option("--attitude", o->run.hand_eye.attitude, "GNSS fixes only: enu | ned")

@@ -24,7 +24,7 @@ struct Options {
   std::vector<double> spacings_s = hand_eye::PairOptions{}.spacings_s;
   double stride_s = 0.1, min_rotation_deg = 1.0, rotation_sigma_deg = 0.05,
          translation_sigma_m = 0.02, max_sigma_m = 0.05, gnss_smoothing_s = 0.05;
-  bool estimate_offset = false;
+  bool estimate_offset = false, no_sweep_motion = false;
 };
 
 void run(const Options& o) {
@@ -48,6 +48,7 @@ void run(const Options& o) {
   so.estimate_offset = o.estimate_offset;
   hand_eye::StepInputs in;
   so.odometry_preset = o.odometry_preset;
+  so.odometry_sweep_motion = !o.no_sweep_motion;
   in.lidar = o.lidar, in.gnss = o.gnss, in.rig_source = o.rig;
   if (!o.lidar.empty() && !o.scans.empty()) throw Error("give --lidar or --scans, not both");
   if (!o.scans.empty()) in.lidar_scans = lidar::scans_folder(o.scans, console_progress());
@@ -89,6 +90,8 @@ void add_hand_eye(CLI::App& app) {
   cmd->add_option("--odometry-preset", o->odometry_preset,
                   "with --scans: os0-128 | os1-64 (default: the rig LiDAR's model)")
       ->check(CLI::IsMember({"os0-128", "os1-64"}));
+  cmd->add_flag("--no-sweep-motion", o->no_sweep_motion,
+                "with --scans: each sweep's motion from the step before, not estimated");
   cmd->add_option("--gnss", o->gnss,
                   "GNSS/INS trajectory (T_enu_gnss; TUM, KITTI, EuRoC, OpenCalib), or a CSV of "
                   "fixes with a header (time, latitude, longitude, height, roll, pitch, yaw), on "

@@ -369,14 +369,16 @@ report::StepResult estimate_extrinsic(const StepInputs& in, const StepOptions& o
     }
   }
   if (preset.empty()) preset = "os0-128";
-  const lidar::OdometryRun run =
-      lidar::run_odometry(in.lidar_scans, lidar::odometry_preset(preset), progress);
+  lidar::OdometryConfig config = lidar::odometry_preset(preset);
+  config.estimate_sweep_motion = o.odometry_sweep_motion;
+  const lidar::OdometryRun run = lidar::run_odometry(in.lidar_scans, config, progress);
   const nlohmann::json odometry = lidar::odometry_report(run);
   const nlohmann::json& s = odometry["summary"];
   out.summary.push_back(fmt::format(
-      "LiDAR odometry (rigcal's, preset {}): {} scans registered of {}, path {:.2f} m, {:.1f} ms a "
-      "scan, {} degenerate steps (odometry.json)",
-      preset, run.T_odom_lidar.size(), run.steps.size(), s["path_length_m"].get<double>(),
+      "LiDAR odometry (rigcal's, preset {}{}): {} scans registered of {}, path {:.2f} m, {:.1f} ms "
+      "a scan, {} degenerate steps (odometry.json)",
+      preset, o.odometry_sweep_motion ? ", each sweep's motion" : "", run.T_odom_lidar.size(),
+      run.steps.size(), s["path_length_m"].get<double>(),
       1e3 * s["registration_seconds_mean"].get<double>(), s["degenerate_steps"].get<size_t>()));
   for (const std::string& n : run.notes) out.notes.push_back("odometry: " + n);
   out = estimate(in, o, run.T_odom_lidar, std::move(out), progress);

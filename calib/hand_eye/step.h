@@ -26,6 +26,9 @@ struct StepOptions {
   // rigcal's odometry on StepInputs::lidar_scans: a lidar::odometry_preset name, or "" for the
   // one the rig's LiDAR model names (lidar::preset_for_model), else os0-128.
   std::string odometry_preset;
+  // And it estimates each sweep's own motion (lidar::OdometryConfig::estimate_sweep_motion): a
+  // motion recording turns and walks the rig, which the motion of the step before lags.
+  bool odometry_sweep_motion = true;
 };
 
 struct StepInputs {

@@ -24,10 +24,10 @@ struct OdometryConfig {
   bool deskew = true;
   int deskew_passes = 2;  // 2: deskew again with the estimated motion and refine
   // Estimate each sweep's own motion with its pose (register_sweep) instead of taking the motion
-  // of the step before it, with a prior about that step's motion of these sigmas (per axis, over
-  // the sweep).
+  // of the step before it, with a loose prior about that step's motion of these sigmas (per
+  // axis, over the sweep; chosen on a simulated walk, doc/odometry.md).
   bool estimate_sweep_motion = false;
-  double sweep_motion_sigma_deg = 1.0, sweep_motion_sigma_m = 0.05;
+  double sweep_motion_sigma_deg = 5.0, sweep_motion_sigma_m = 0.3;
   RegistrationConfig registration;
   // A step is called degenerate when the information's weakest direction holds less than this
   // fraction of its strongest (translation and rotation blocks separately).

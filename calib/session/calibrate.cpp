@@ -317,12 +317,12 @@ std::vector<Plan> make_plans(const CalibrateOptions& o, const io::Session& s,
     p.options = fmt::format(
         "sensor {} lidar {} attitude {} spacings {} stride {} min_rotation {} smoothing {} "
         "rotation_sigma {} translation_sigma {} max_sigma {} estimate_offset {} fixed {} "
-        "duplicates {} max_gap {} huber {} estimate_scale {} odometry_preset {}",
+        "duplicates {} max_gap {} huber {} estimate_scale {} odometry_preset {} sweep_motion {}",
         h.sensor, h.lidar_sensor, h.attitude, fmt::join(h.pairs.spacings_s, ","), h.pairs.stride_s,
         h.pairs.min_rotation_deg, h.pairs.gnss_half_window_s, h.refine.rotation_sigma_deg,
         h.refine.translation_sigma_m, h.max_sigma_m, h.estimate_offset, fixed,
         static_cast<int>(h.duplicates), h.pairs.max_gap_s, h.refine.huber, h.refine.estimate_scale,
-        h.odometry_preset.empty() ? "rig" : h.odometry_preset);
+        h.odometry_preset.empty() ? "rig" : h.odometry_preset, h.odometry_sweep_motion);
     p.run = [odometry, scans, gnss, h](const rig::Rig& rig, const report::Progress& pr) {
       hand_eye::StepInputs in;
       in.lidar = odometry;
