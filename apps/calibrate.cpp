@@ -10,6 +10,7 @@
 
 #include "cli.h"
 #include "rigcal/core/text.h"
+#include "rigcal/lidar/odometry.h"
 #include "step_output.h"
 
 namespace rigcal::cli {
@@ -124,7 +125,7 @@ void add_calibrate(CLI::App& app) {
                   "default: rigcal's own on the motion recording's ouster_points/");
   cmd->add_option("--odometry-preset", o->run.hand_eye.odometry_preset,
                   "rigcal's odometry preset: os0-128 | os1-64 (default: the rig LiDAR's model)")
-      ->check(CLI::IsMember({"os0-128", "os1-64"}));
+      ->check(CLI::IsMember(lidar::preset_names()));
   cmd->add_flag("--no-sweep-motion", o->no_sweep_motion,
                 "rigcal's odometry takes each sweep's motion from the step before instead of "
                 "estimating it (doc/odometry.md)");

@@ -89,7 +89,7 @@ void add_hand_eye(CLI::App& app) {
                   "runs first; its trajectory joins the report");
   cmd->add_option("--odometry-preset", o->odometry_preset,
                   "with --scans: os0-128 | os1-64 (default: the rig LiDAR's model)")
-      ->check(CLI::IsMember({"os0-128", "os1-64"}));
+      ->check(CLI::IsMember(lidar::preset_names()));
   cmd->add_flag("--no-sweep-motion", o->no_sweep_motion,
                 "with --scans: each sweep's motion from the step before, not estimated");
   cmd->add_option("--gnss", o->gnss,

@@ -78,7 +78,7 @@ void add_odometry(CLI::App& app) {
   cmd->add_option("--report", o->report, "report folder: odometry.json, one row a step");
   cmd->add_option("--sensor", o->sensor,
                   "preset: os0-128 (hand-held, 0.5 m voxels, 50 m) | os1-64 (car, 1 m, 100 m)")
-      ->check(CLI::IsMember({"os0-128", "os1-64"}))
+      ->check(CLI::IsMember(lidar::preset_names()))
       ->capture_default_str();
   cmd->add_option("--voxel-size", o->voxel_size_m, "map voxel size, m (overrides the preset)")
       ->check(finite_number(false) & CLI::PositiveNumber);

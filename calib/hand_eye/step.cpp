@@ -19,6 +19,12 @@
 namespace rigcal::hand_eye {
 namespace {
 
+io::TrajectoryReadOptions read_options(const StepOptions& o) {
+  io::TrajectoryReadOptions read;
+  read.duplicates = o.duplicates;
+  return read;
+}
+
 // The GNSS/INS trajectory: poses as they are, or fixes (latitude, longitude, height, attitude)
 // turned into a local ENU frame at the first fix.
 Trajectory read_gnss(const StepInputs& in, const StepOptions& o,
@@ -120,8 +126,7 @@ report::StepResult estimate(const StepInputs& in, const StepOptions& o, const Tr
     T_base_lidar = l->T_base_sensor;
     prior_T_gnss_lidar = g->T_base_sensor.inverse() * T_base_lidar;
   }
-  io::TrajectoryReadOptions read;
-  read.duplicates = o.duplicates;
+  const io::TrajectoryReadOptions read = read_options(o);
   std::vector<std::string>& notes = out.notes;
   report::tell(progress, "reading the GNSS/INS trajectory", 0, 1);
   const Trajectory gnss = read_gnss(in, o, read, notes);
@@ -347,28 +352,15 @@ report::StepResult estimate_extrinsic(const StepInputs& in, const StepOptions& o
   report::StepResult out;
   if (in.lidar_scans.empty()) {
     out.inputs = {{"lidar odometry", in.lidar}, {"gnss", in.gnss}};
-    io::TrajectoryReadOptions read;
-    read.duplicates = o.duplicates;
     report::tell(progress, "reading the LiDAR odometry", 0, 1);
-    const Trajectory lidar = io::read_trajectory(in.lidar, read).trajectory;
+    const Trajectory lidar = io::read_trajectory(in.lidar, read_options(o)).trajectory;
     report::tell(progress, "reading the LiDAR odometry", 1, 1);
     return estimate(in, o, lidar, std::move(out), progress);
   }
   // rigcal's own odometry on the scans, with the preset the rig's LiDAR names.
   out.inputs = {{"lidar scans", in.lidar_scans}, {"gnss", in.gnss}};
-  std::string preset = o.odometry_preset;
-  if (preset.empty() && in.rig) {
-    if (const rig::Sensor* l = rig::find_sensor(*in.rig, o.lidar_sensor)) {
-      preset = lidar::preset_for_model(l->model);
-      if (preset.empty() && !l->model.empty()) {
-        out.notes.push_back(
-            fmt::format("odometry: the LiDAR's model '{}' names no preset; os0-128's is used (give "
-                        "--odometry-preset)",
-                        l->model));
-      }
-    }
-  }
-  if (preset.empty()) preset = "os0-128";
+  const std::string preset = lidar::choose_preset(
+      o.odometry_preset, in.rig ? rig::find_sensor(*in.rig, o.lidar_sensor) : nullptr, out.notes);
   lidar::OdometryConfig config = lidar::odometry_preset(preset);
   config.estimate_sweep_motion = o.odometry_sweep_motion;
   const lidar::OdometryRun run = lidar::run_odometry(in.lidar_scans, config, progress);

@@ -52,6 +52,8 @@ OdometryConfig os1_64_car() {
   return c;
 }
 
+std::vector<std::string> preset_names() { return {"os0-128", "os1-64"}; }
+
 OdometryConfig odometry_preset(const std::string& name) {
   if (name == "os0-128") return os0_128_handheld();
   if (name == "os1-64") return os1_64_car();

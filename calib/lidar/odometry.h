@@ -45,7 +45,9 @@ struct OdometryConfig {
 // Presets for the Ouster models of the VBR rig.
 OdometryConfig os0_128_handheld();  // 10 Hz, indoor and outdoor on foot: 0.5 m voxels, 50 m
 OdometryConfig os1_64_car();        // 20 Hz, streets: 1.0 m voxels, 100 m
-// "os0-128" | "os1-64"; throws rigcal::Error naming the choices otherwise.
+// The presets' names, for option checks: "os0-128", "os1-64".
+std::vector<std::string> preset_names();
+// One of preset_names(); throws rigcal::Error naming the choices otherwise.
 OdometryConfig odometry_preset(const std::string& name);
 // The preset for a rig's LiDAR `model` ("OS0-128", "Ouster OS1-64", ...): "os0-128" for an OS0,
 // "os1-64" for an OS1, "" for a model neither names.

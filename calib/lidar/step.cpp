@@ -227,4 +227,18 @@ nlohmann::json odometry_report(const OdometryRun& run) {
   return j;
 }
 
+std::string choose_preset(const std::string& given, const rig::Sensor* lidar,
+                          std::vector<std::string>& notes) {
+  if (!given.empty()) return given;
+  const std::string preset = lidar ? preset_for_model(lidar->model) : "";
+  if (!preset.empty()) return preset;
+  if (lidar && !lidar->model.empty()) {
+    notes.push_back(
+        fmt::format("odometry: the LiDAR's model '{}' names no preset; os0-128's is used (give "
+                    "--odometry-preset)",
+                    lidar->model));
+  }
+  return "os0-128";
+}
+
 }  // namespace rigcal::lidar

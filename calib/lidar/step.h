@@ -9,6 +9,7 @@
 #include "rigcal/io/odometry_io.h"
 #include "rigcal/lidar/odometry.h"
 #include "rigcal/report/step.h"
+#include "rigcal/rig/rig.h"
 
 namespace rigcal::lidar {
 
@@ -43,6 +44,11 @@ OdometryRun run_odometry(const std::filesystem::path& scans, const OdometryConfi
 
 // The covariance of every motion between consecutive registered scans (skipped scans have none).
 std::vector<io::StepCovariance> step_covariances(const OdometryRun& run);
+
+// The preset a step runs the odometry with: `given` when not empty, else the one the rig LiDAR's
+// model names (preset_for_model), else os0-128, with a note in `notes` saying so.
+std::string choose_preset(const std::string& given, const rig::Sensor* lidar,
+                          std::vector<std::string>& notes);
 
 // The report: the configuration, a summary (frames, path length, timing, degenerate steps) and
 // one row a step (doc/odometry.md says what each number is).

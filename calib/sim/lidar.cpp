@@ -211,4 +211,14 @@ std::vector<LidarPoint> sweep(const Scene& scene, const LidarModel& m,
   return out;
 }
 
+Scan scan_of(const std::vector<LidarPoint>& points, Time stamp) {
+  Scan scan;
+  scan.stamp = stamp;
+  scan.point_times = true;
+  scan.points.reserve(points.size());
+  for (const LidarPoint& p : points)
+    scan.points.push_back({.p = p.p, .t_ns = p.t_ns, .intensity = p.intensity, .ring = p.ring});
+  return scan;
+}
+
 }  // namespace rigcal::sim

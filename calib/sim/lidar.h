@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "rigcal/camera/target.h"
+#include "rigcal/core/scan.h"
 #include "rigcal/core/se3.h"
 
 namespace rigcal::sim {
@@ -54,6 +55,10 @@ struct LidarPoint {
   uint32_t t_ns = 0;  // since the start of the sweep
   int object = 0;     // the scene object hit (truth, not written to .bin)
 };
+
+// The sweep as the odometry reads it (what the written .bin and its sidecar give): each point
+// with its time, intensity and ring.
+Scan scan_of(const std::vector<LidarPoint>& points, Time stamp);
 
 // One sweep starting at motion time t0; T_world_lidar(t) gives the sensor pose during it.
 std::vector<LidarPoint> sweep(const Scene& scene, const LidarModel& model,

@@ -173,7 +173,8 @@ TrajectoryPart simulate_trajectories(const rig::Rig& rig, const SimConfig& cfg,
     source = pose_source(motion);
   }
   const rig::Sensor& base = rig::sensor(rig, rig.base_frame);
-  const double rate = base.update_rate.value_or(10.0);
+  part.rate_hz = base.update_rate.value_or(10.0);
+  const double rate = part.rate_hz;
   const Time start = Time::from_seconds(cfg.base_start_s);
   part.truth_base = sample_poses(source, rate, duration, start);
   part.source = source;
@@ -322,7 +323,7 @@ SweepDrive trajectory_drive(const rig::Rig& rig, const SimConfig& cfg, const Tra
   };
   drive.lidar = cfg.lidar;
   // A sweep every pose: the rate the poses are sampled at.
-  drive.lidar.rate_hz = rig::sensor(rig, rig.base_frame).update_rate.value_or(10.0);
+  drive.lidar.rate_hz = part.rate_hz;
   drive.base_start_s = cfg.base_start_s;
   drive.first_s = 0.0;
   return drive;

@@ -81,6 +81,7 @@ struct ImuPart {
 
 struct TrajectoryPart {
   Trajectory truth_base;  // T_world_lidar at the LiDAR rate
+  double rate_hz = 10.0;  // truth_base's: the base sensor's update rate
   Trajectory odometry;    // T_odom_lidar
   Trajectory gnss;        // T_enu_gnss on the GNSS clock
   std::vector<size_t> gnss_outliers;

@@ -39,13 +39,7 @@ struct Drive {
   std::vector<SE3> T_world_lidar;
 };
 
-Scan scan_of(const sim::Sweep& sweep) {
-  Scan s;
-  s.stamp = sweep.stamp;
-  s.points.reserve(sweep.points.size());
-  for (const sim::LidarPoint& p : sweep.points) s.points.push_back({.p = p.p, .t_ns = p.t_ns});
-  return s;
-}
+Scan scan_of(const sim::Sweep& sweep) { return sim::scan_of(sweep.points, sweep.stamp); }
 
 // 0: OS0-128 at 10 Hz; 1: OS1-64 at 20 Hz.
 sim::SimConfig drive_config(int sensor, int scans) {

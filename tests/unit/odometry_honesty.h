@@ -35,11 +35,7 @@ inline HonestyFigures odometry_honesty(const sim::LidarModel& sensor, const Odom
     std::printf("[ figures ] seed %d: step NEES", int(seed));
     for (int k = 0; k < sweeps; ++k) {
       const sim::Sweep sweep = sim::next_sweep(street);
-      Scan scan;
-      scan.stamp = sweep.stamp;
-      for (const sim::LidarPoint& p : sweep.points)
-        scan.points.push_back({.p = p.p, .t_ns = p.t_ns});
-      const Step step = register_scan(odometry, scan);
+      const Step step = register_scan(odometry, sim::scan_of(sweep.points, sweep.stamp));
       EXPECT_EQ(step.skipped, "");
       T_world_lidar.push_back(sweep.T_world_lidar);
       if (k == 0) continue;

@@ -128,11 +128,8 @@ struct SpinningInARoom {
     return T;
   }
   Scan sweep(double t0, std::mt19937_64& rng) const {
-    Scan scan;
-    scan.stamp = Time::from_seconds(t0);
-    for (const sim::LidarPoint& p : sim::sweep(scene, sim::os0_128(), T_world_lidar, t0, rng))
-      scan.points.push_back({.p = p.p, .t_ns = p.t_ns});
-    return scan;
+    return sim::scan_of(sim::sweep(scene, sim::os0_128(), T_world_lidar, t0, rng),
+                        Time::from_seconds(t0));
   }
   // Distance to the nearest wall, floor or ceiling (the box's points are left out).
   static double room_distance(const Eigen::Vector3d& q) {
@@ -216,10 +213,7 @@ TEST(Deskew, EstimatingEachSweepsMotionFollowsAWalkBetter) {
   std::vector<Scan> scans;
   for (size_t k = 0; k < part.truth_base.size(); ++k) {
     const sim::Sweep sweep = sim::next_sweep(drive);
-    Scan scan;
-    scan.stamp = sweep.stamp;
-    for (const sim::LidarPoint& p : sweep.points) scan.points.push_back({.p = p.p, .t_ns = p.t_ns});
-    scans.push_back(std::move(scan));
+    scans.push_back(sim::scan_of(sweep.points, sweep.stamp));
     EXPECT_EQ(sweep.stamp, part.truth_base.stamps[k]);
   }
   auto vertical_rms = [&](bool sweep_motion) {
@@ -313,13 +307,12 @@ TEST(OdometryHonesty, StepErrorsLieWithinThreeSigmaInAtLeast95PercentOfSteps) {
 // its weakest direction the corridor's axis, with a sigma far above the others'.
 // Disabled, open: the axis is found the weakest, but it holds 6-10 % of the strongest
 // translation information, not ~0. About 5 % of the planes have their normal along the
-// corridor: their 8 map points lie in one cross-section of it (an L across a wall and the floor
-// or ceiling). A scan ring meets a narrow corridor at nearly one distance, so far away the
-// map's points come in cross-sections (rings 0.35 deg apart meet the floor 3.7 m apart at 27 m),
-// and near the sensor one scan column's points do the same. Changing which point a voxel keeps
-// (the first, the one nearest the centre, a pseudo-random one: all measured) does not remove
-// them; planes need points from more than one ring or column (the map would keep each point's
-// ring and sweep) or a neighbourhood checked for two surfaces.
+// corridor. Most of them are ceiling points near the sensor, built from the same rays measured
+// again sweep after sweep (the estimated motion along the axis is nearly zero), the range noise
+// spreading each ray's points along it. Measured and not kept: KISS-ICP's minimum spacing between
+// the points of a voxel cuts those planes from 1253 to 48 but the ratio only to 6-8 %; refusing
+// neighbourhoods from one scan line (one sweep, one ring or column) changes nothing. The rest of
+// the information along the axis is not yet traced.
 TEST(Degeneracy, DISABLED_ACorridorLeavesTheMotionAlongItFree) {
   sim::Scene scene;
   sim::add_room(scene, 200.0, 1.5, -1.2, 1.5);
@@ -332,10 +325,8 @@ TEST(Degeneracy, DISABLED_ACorridorLeavesTheMotionAlongItFree) {
   Odometry o = start_odometry(os0_128_handheld());
   std::vector<Step> steps;
   for (int k = 0; k < 5; ++k) {
-    Scan scan;
-    scan.stamp = Time::from_seconds(0.1 * k);
-    for (const sim::LidarPoint& p : sim::sweep(scene, sim::os0_128(), T_world_lidar, 0.1 * k, rng))
-      scan.points.push_back({.p = p.p, .t_ns = p.t_ns});
+    const Scan scan = sim::scan_of(sim::sweep(scene, sim::os0_128(), T_world_lidar, 0.1 * k, rng),
+                                   Time::from_seconds(0.1 * k));
     steps.push_back(register_scan(o, scan));
   }
   for (size_t k = 1; k < steps.size(); ++k) {
