@@ -27,7 +27,20 @@ std::string lower(std::string_view s) {
 }
 
 // The header's column index of each name (first of its aliases), -1 when absent.
-enum Column { kTime, kLat, kLon, kHeight, kRoll, kPitch, kYaw, kStdE, kStdN, kStdU, kColumns };
+enum Column {
+  kTime,
+  kLat,
+  kLon,
+  kHeight,
+  kRoll,
+  kPitch,
+  kYaw,
+  kStdE,
+  kStdN,
+  kStdU,
+  kStatus,
+  kColumns
+};
 const std::array<std::vector<std::string_view>, kColumns> kAliases = {{
     {"time", "t", "timestamp", "stamp"},
     {"latitude", "lat"},
@@ -39,6 +52,7 @@ const std::array<std::vector<std::string_view>, kColumns> kAliases = {{
     {"std_east", "sigma_east"},
     {"std_north", "sigma_north"},
     {"std_up", "sigma_up"},
+    {"status"},
 }};
 
 }  // namespace
@@ -64,7 +78,8 @@ bool is_gnss_fixes_file(const std::filesystem::path& path) {
   return false;
 }
 
-GnssFixes parse_gnss_fixes(std::string_view text, std::string_view file_name, Attitude attitude,
+GnssFixes parse_gnss_fixes(std::string_view text, std::string_view file_name,
+                           std::optional<Attitude> attitude,
                            const std::optional<GeodeticOrigin>& origin) {
   // The header: the first non-empty, non-comment line.
   std::array<int, kColumns> col;
@@ -89,12 +104,12 @@ GnssFixes parse_gnss_fixes(std::string_view text, std::string_view file_name, At
             col[c] = static_cast<int>(i);
         }
       }
-      for (int c = 0; c <= kYaw; ++c) {
+      for (int c = 0; c <= (attitude ? kYaw : kHeight); ++c) {
         if (col[c] < 0) {
           fail_at(file_name, line_no, "",
                   fmt::format("the header has no '{}' column (GNSS fixes need time, latitude, "
-                              "longitude, height, roll, pitch, yaw)",
-                              kAliases[c].front()));
+                              "longitude, height{})",
+                              kAliases[c].front(), attitude ? ", roll, pitch, yaw" : ""));
         }
       }
       continue;
@@ -104,6 +119,7 @@ GnssFixes parse_gnss_fixes(std::string_view text, std::string_view file_name, At
   if (rows.empty()) fail_at(file_name, header_line, "", "no fixes after the header");
 
   GnssFixes out;
+  out.has_attitude = attitude.has_value();
   GeographicLib::LocalCartesian enu;
   std::vector<double> std_h, std_v;
   const Eigen::Matrix3d R_enu_ned = (Eigen::Matrix3d() << 0, 1, 0, 1, 0, 0, 0, 0, -1).finished();
@@ -157,20 +173,40 @@ GnssFixes parse_gnss_fixes(std::string_view text, std::string_view file_name, At
     }
     SE3 T;
     enu.Forward(lat, lon, h, T.t.x(), T.t.y(), T.t.z());
-    const double roll = value(kRoll) * deg, pitch = value(kPitch) * deg, yaw = value(kYaw) * deg;
-    T.R = attitude == Attitude::enu ? from_roll_pitch_yaw(roll, pitch, yaw)
-                                    : R_enu_ned * from_roll_pitch_yaw(roll, pitch, yaw);
+    if (attitude) {
+      const double roll = value(kRoll) * deg, pitch = value(kPitch) * deg, yaw = value(kYaw) * deg;
+      T.R = *attitude == Attitude::enu ? from_roll_pitch_yaw(roll, pitch, yaw)
+                                       : R_enu_ned * from_roll_pitch_yaw(roll, pitch, yaw);
+    }
     out.T_enu_gnss.stamps.push_back(stamp);
     out.T_enu_gnss.T_world_body.push_back(T);
     if (col[kStdE] >= 0 && col[kStdN] >= 0) std_h.push_back(std::hypot(value(kStdE), value(kStdN)));
     if (col[kStdU] >= 0) std_v.push_back(value(kStdU));
+    if (col[kStdE] >= 0 && col[kStdN] >= 0 && col[kStdU] >= 0) {
+      const Eigen::Vector3d s(value(kStdE), value(kStdN), value(kStdU));
+      if (!(s.minCoeff() >= 0) || !s.allFinite()) {
+        fail_at(file_name, number, "",
+                fmt::format("standard deviations {} {} {}: expected numbers >= 0 (m)", s.x(), s.y(),
+                            s.z()));
+      }
+      out.std_enu_m.push_back(s);
+    }
+    if (col[kStatus] >= 0) {
+      const double status = value(kStatus);
+      if (status != -1 && status != 0 && status != 1 && status != 2) {
+        fail_at(file_name, number, "",
+                fmt::format("status {}: expected -1 (no fix), 0 (fix), 1 (SBAS) or 2 (GBAS, RTK)",
+                            status));
+      }
+      out.status.push_back(static_cast<int>(status));
+    }
   }
   if (!std_h.empty()) out.median_horizontal_std_m = median(std_h);
   if (!std_v.empty()) out.median_vertical_std_m = median(std_v);
   return out;
 }
 
-GnssFixes read_gnss_fixes(const std::filesystem::path& path, Attitude attitude,
+GnssFixes read_gnss_fixes(const std::filesystem::path& path, std::optional<Attitude> attitude,
                           const std::optional<GeodeticOrigin>& origin) {
   return parse_gnss_fixes(read_text_file(path), path.string(), attitude, origin);
 }

@@ -2,13 +2,17 @@
 // GNSS/INS fixes as CSV (doc/hand-eye.md, "GNSS fixes"): a header line naming the columns, then
 // one fix a line. Required columns (any order, case-insensitive): time (or t, timestamp: seconds
 // or ISO-8601 UTC), latitude (lat), longitude (lon), height (alt, altitude: ellipsoidal, m), roll,
-// pitch, yaw (or heading), in degrees. Optional: the standard deviations std_east, std_north,
-// std_up (m). Converted with GeographicLib to a local ENU frame at the first fix (or a given
-// origin): T_enu_gnss, the body frame being the one the attitude convention defines.
+// pitch, yaw (or heading), in degrees; read for positions only (no attitude convention given),
+// the attitude columns are not needed. Optional: the standard deviations std_east, std_north,
+// std_up (m), and status (sensor_msgs/NavSatFix's: -1 no fix, 0 fix, 1 SBAS, 2 GBAS/RTK; what
+// `rigcal convert` writes to navsat.csv). Converted with GeographicLib to a local ENU frame at the
+// first fix (or a given origin): T_enu_gnss, the body frame being the one the attitude convention
+// defines.
 #include <filesystem>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "rigcal/core/trajectory.h"
 
@@ -29,8 +33,11 @@ struct GeodeticOrigin {
 };
 
 struct GnssFixes {
-  Trajectory T_enu_gnss;
-  GeodeticOrigin origin;                                                 // of the ENU frame
+  Trajectory T_enu_gnss;  // without attitude (has_attitude false) every rotation is the identity
+  bool has_attitude = true;
+  std::vector<Eigen::Vector3d> std_enu_m;  // one a fix when the file gives them, else empty
+  std::vector<int> status;                 // one a fix when the file gives it, else empty
+  GeodeticOrigin origin;                   // of the ENU frame
   std::optional<double> median_horizontal_std_m, median_vertical_std_m;  // when given
 };
 
@@ -39,9 +46,11 @@ bool is_gnss_fixes_file(const std::filesystem::path& path);
 
 // Throws rigcal::Error naming file, line and column on a missing column, a bad number, a
 // latitude outside [-90, 90], stamps that do not increase.
-GnssFixes parse_gnss_fixes(std::string_view text, std::string_view file_name, Attitude attitude,
+// `attitude` none: positions only.
+GnssFixes parse_gnss_fixes(std::string_view text, std::string_view file_name,
+                           std::optional<Attitude> attitude,
                            const std::optional<GeodeticOrigin>& origin = std::nullopt);
-GnssFixes read_gnss_fixes(const std::filesystem::path& path, Attitude attitude,
+GnssFixes read_gnss_fixes(const std::filesystem::path& path, std::optional<Attitude> attitude,
                           const std::optional<GeodeticOrigin>& origin = std::nullopt);
 
 }  // namespace rigcal::io
