@@ -63,6 +63,8 @@ void add_publish(CLI::App& app);
 void add_convert(CLI::App& app);
 // `rigcal odometry`
 void add_odometry(CLI::App& app);
+// `rigcal ground-truth`
+void add_ground_truth(CLI::App& app);
 // `rigcal target print`
 void add_target_print(CLI::App& target);
 

@@ -31,7 +31,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.footer(
       "Exit status: 0 success, 2 bad input (the message names file, line and key), 1 bug;\n"
-      "3 when the data do not determine the answer (time-offset, hand-eye, calibrate).");
+      "3 when the data do not determine the answer (time-offset, hand-eye, calibrate,\n"
+      "ground-truth).");
 
   rigcal::cli::add_calibrate(app);
   rigcal::cli::add_publish(app);
@@ -48,6 +49,7 @@ int main(int argc, char** argv) {
   rigcal::cli::add_hand_eye(app);
   rigcal::cli::add_lidar_camera(app);
   rigcal::cli::add_odometry(app);
+  rigcal::cli::add_ground_truth(app);
   CLI::App* target = app.add_subcommand("target", "Calibration targets: printable PDFs");
   target->require_subcommand(1);
   rigcal::cli::add_target_print(*target);

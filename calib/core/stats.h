@@ -26,4 +26,11 @@ inline double median_midpoint(std::vector<double> v) {
   return 0.5 * (lower + upper);
 }
 
+// The root mean square; 0 when empty.
+inline double rms(const std::vector<double>& v) {
+  double sum = 0;
+  for (double x : v) sum += x * x;
+  return v.empty() ? 0.0 : std::sqrt(sum / double(v.size()));
+}
+
 }  // namespace rigcal

@@ -1,0 +1,430 @@
+#include "rigcal/gt/pose_graph.h"
+
+#include <ceres/ceres.h>
+#include <fmt/format.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/SparseCore>
+#include <algorithm>
+#include <cmath>
+
+#include "rigcal/bench/metrics.h"
+#include "rigcal/core/error.h"
+#include "rigcal/gt/position_prior_error.h"
+#include "rigcal/gt/relative_pose_error.h"
+
+namespace rigcal::gt {
+namespace {
+
+// U with U' U = covariance^-1; directions of (numerically) zero variance get a large but finite
+// weight rather than an infinite one.
+template <int N>
+Eigen::Matrix<double, N, N> sqrt_information(const Eigen::Matrix<double, N, N>& covariance) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, N, N>> eigen(covariance);
+  const double largest = std::max(eigen.eigenvalues().maxCoeff(), 1e-300);
+  Eigen::Matrix<double, N, 1> inv_sqrt;
+  for (int i = 0; i < N; ++i)
+    inv_sqrt(i) = 1.0 / std::sqrt(std::max(eigen.eigenvalues()(i), 1e-16 * largest));
+  return inv_sqrt.asDiagonal() * eigen.eigenvectors().transpose();
+}
+
+Eigen::Matrix3d covariance_of(const Eigen::Vector2d& sigma_h_v) {
+  return Eigen::Vector3d(sigma_h_v.x() * sigma_h_v.x(), sigma_h_v.x() * sigma_h_v.x(),
+                         sigma_h_v.y() * sigma_h_v.y())
+      .asDiagonal();
+}
+
+// A prior at scan `node`: the fix interpolated at its stamp.
+struct Prior {
+  size_t node = 0, fix = 0;
+  Eigen::Vector3d p_enu = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
+};
+
+std::vector<Prior> priors_at_scans(const Trajectory& scans, const std::vector<PositionFix>& fixes,
+                                   const PoseGraphConfig& config, std::vector<bool>& fix_used) {
+  std::vector<Prior> out;
+  fix_used.assign(fixes.size(), false);
+  const Time max_gap = Time::from_seconds(config.max_fix_gap_s);
+  size_t i = 0;  // fixes[i] is the last fix at or before the scan
+  for (size_t k = 0; k < scans.size(); ++k) {
+    const Time t = scans.stamps[k];
+    while (i + 1 < fixes.size() && fixes[i + 1].stamp <= t) ++i;
+    if (fixes.empty() || fixes[i].stamp > t) continue;
+    Prior p;
+    p.node = k;
+    if (fixes[i].stamp == t) {
+      p.fix = i;
+      p.p_enu = fixes[i].p_enu;
+      p.covariance = fixes[i].covariance;
+    } else {
+      if (i + 1 >= fixes.size() || fixes[i + 1].stamp - fixes[i].stamp > max_gap) continue;
+      const PositionFix &a = fixes[i], &b = fixes[i + 1];
+      const double f = (t - a.stamp).seconds() / (b.stamp - a.stamp).seconds();
+      p.fix = f < 0.5 ? i : i + 1;
+      p.p_enu = (1 - f) * a.p_enu + f * b.p_enu;
+      // The less certain of the two (by the trace): a quality change is not averaged away.
+      p.covariance = a.covariance.trace() >= b.covariance.trace() ? a.covariance : b.covariance;
+    }
+    fix_used[p.fix] = true;
+    out.push_back(p);
+  }
+  return out;
+}
+
+// The rotation and translation taking odometry positions onto fix positions (least squares);
+// `spread_axes`: how many axes of the fixes' spread exceed min_spread_m (0, 1 or 3: a point, a
+// line, a plane or a volume). With fewer than 2 the rotation is the odometry's about the missing
+// axes: with a line, the smallest rotation taking the odometry's line onto the fixes'.
+SE3 initial_alignment(const std::vector<Eigen::Vector3d>& p_odom,
+                      const std::vector<Eigen::Vector3d>& p_enu, double min_spread_m,
+                      int& spread_axes) {
+  const size_t n = p_enu.size();
+  Eigen::Vector3d mean_odom = Eigen::Vector3d::Zero(), mean_enu = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < n; ++i) mean_odom += p_odom[i], mean_enu += p_enu[i];
+  mean_odom /= double(n), mean_enu /= double(n);
+  Eigen::Matrix3d scatter_enu = Eigen::Matrix3d::Zero(), scatter_odom = Eigen::Matrix3d::Zero();
+  for (size_t i = 0; i < n; ++i) {
+    scatter_enu += (p_enu[i] - mean_enu) * (p_enu[i] - mean_enu).transpose();
+    scatter_odom += (p_odom[i] - mean_odom) * (p_odom[i] - mean_odom).transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> enu(scatter_enu / double(n)),
+      odom(scatter_odom / double(n));
+  const double s2 = min_spread_m * min_spread_m;
+  spread_axes = enu.eigenvalues()(1) >= s2 ? 2 : enu.eigenvalues()(2) >= s2 ? 1 : 0;
+  SE3 T_enu_odom;
+  if (spread_axes == 2) {
+    std::vector<SE3> a(n), b(n);
+    for (size_t i = 0; i < n; ++i) a[i].t = p_enu[i], b[i].t = p_odom[i];
+    T_enu_odom = bench::align(a, b, bench::Alignment::se3).T_gt_est;
+  } else if (spread_axes == 1) {
+    Eigen::Vector3d d_enu = enu.eigenvectors().col(2), d_odom = odom.eigenvectors().col(2);
+    // Same sense: from the first position to the last.
+    if (d_enu.dot(p_enu.back() - p_enu.front()) < 0) d_enu = -d_enu;
+    if (d_odom.dot(p_odom.back() - p_odom.front()) < 0) d_odom = -d_odom;
+    T_enu_odom.R = Eigen::Quaterniond::FromTwoVectors(d_odom, d_enu).toRotationMatrix();
+  }
+  T_enu_odom.t = mean_enu - T_enu_odom.R * mean_odom;
+  return T_enu_odom;
+}
+
+// Pose k's parameters, as Ceres' pose_graph_3d keeps them.
+struct PoseBlock {
+  Eigen::Quaterniond q;
+  Eigen::Vector3d t;
+};
+
+struct Graph {
+  std::vector<PoseBlock> poses;
+  ceres::Problem problem;
+  std::vector<ceres::ResidualBlockId> prior_blocks;
+};
+
+ceres::LinearSolverType sparse_solver() {
+  return ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE) ||
+                 ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::EIGEN_SPARSE)
+             ? ceres::SPARSE_NORMAL_CHOLESKY
+             : ceres::DENSE_QR;
+}
+
+// The graph over the poses with the odometry's edges and the priors not rejected; the first
+// pose's rotation held when the fixes do not determine it.
+void build(Graph& g, const OdometryInput& odometry, const std::vector<Prior>& priors,
+           const std::vector<PriorResidual>& state, const Eigen::Vector3d& p_lidar_antenna,
+           double robust_sigmas, double prior_scale, bool hold_rotation) {
+  const std::vector<SE3>& T_odom_lidar = odometry.T_odom_lidar.T_world_body;
+  for (size_t k = 0; k + 1 < g.poses.size(); ++k) {
+    const SE3 T_prev_cur = T_odom_lidar[k].inverse() * T_odom_lidar[k + 1];
+    auto* cost = new ceres::AutoDiffCostFunction<RelativePoseError, 6, 4, 3, 4, 3>(
+        new RelativePoseError{T_prev_cur.quaternion(), T_prev_cur.t,
+                              sqrt_information<6>(odometry.step_covariance[k])});
+    g.problem.AddResidualBlock(cost, nullptr, g.poses[k].q.coeffs().data(), g.poses[k].t.data(),
+                               g.poses[k + 1].q.coeffs().data(), g.poses[k + 1].t.data());
+  }
+  for (size_t j = 0; j < priors.size(); ++j) {
+    if (state[j].rejected) continue;
+    const Prior& p = priors[j];
+    auto* cost =
+        new ceres::AutoDiffCostFunction<PositionPriorError, 3, 4, 3>(new PositionPriorError{
+            p.p_enu, p_lidar_antenna, sqrt_information<3>(prior_scale * p.covariance)});
+    ceres::LossFunction* loss = robust_sigmas > 0 ? new ceres::HuberLoss(robust_sigmas) : nullptr;
+    g.prior_blocks.push_back(g.problem.AddResidualBlock(
+        cost, loss, g.poses[p.node].q.coeffs().data(), g.poses[p.node].t.data()));
+  }
+  for (PoseBlock& b : g.poses)
+    g.problem.SetManifold(b.q.coeffs().data(), new ceres::EigenQuaternionManifold);
+  if (hold_rotation) g.problem.SetParameterBlockConstant(g.poses.front().q.coeffs().data());
+}
+
+ceres::Solver::Summary solve(Graph& g, int max_iterations) {
+  ceres::Solver::Options options;
+  options.linear_solver_type = sparse_solver();
+  options.max_num_iterations = max_iterations;
+  options.num_threads = 2;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &g.problem, &summary);
+  return summary;
+}
+
+// Each pose's covariance from the Jacobian at the solution, in rigcal's tangent: Ceres' quaternion
+// tangent is half the rotation vector (Plus(q, d) = [cos |d|, sin |d| d / |d|] * q, left).
+std::vector<Matrix6d> pose_covariances(Graph& g) {
+  const size_t n = g.poses.size();
+  ceres::Problem::EvaluateOptions eo;
+  for (PoseBlock& b : g.poses) {
+    eo.parameter_blocks.push_back(b.q.coeffs().data());
+    eo.parameter_blocks.push_back(b.t.data());
+  }
+  eo.apply_loss_function = false;
+  eo.num_threads = 2;
+  ceres::CRSMatrix J;
+  if (!g.problem.Evaluate(eo, nullptr, nullptr, nullptr, &J)) return {};
+  if (J.num_cols != int(6 * n)) return {};
+  std::vector<Matrix6d> D(n, Matrix6d::Zero()), B(n > 0 ? n - 1 : 0, Matrix6d::Zero());
+  // Every row touches one pose (a prior) or two consecutive ones (an edge).
+  for (int r = 0; r < J.num_rows; ++r) {
+    for (int a = J.rows[r]; a < J.rows[r + 1]; ++a) {
+      for (int b = J.rows[r]; b < J.rows[r + 1]; ++b) {
+        const int ca = J.cols[a], cb = J.cols[b];
+        const size_t ka = size_t(ca) / 6, kb = size_t(cb) / 6;
+        const double v = J.values[a] * J.values[b];
+        if (ka == kb)
+          D[ka](ca % 6, cb % 6) += v;
+        else if (kb == ka + 1)
+          B[ka](ca % 6, cb % 6) += v;
+      }
+    }
+  }
+  std::vector<Matrix6d> C = chain_marginals(D, B);
+  // From Ceres' tangent (d_rot, d_t) to rigcal's (2 d_rot, d_t).
+  const Vector6d scale = (Vector6d() << 2, 2, 2, 1, 1, 1).finished();
+  for (Matrix6d& c : C) c = scale.asDiagonal() * c * scale.asDiagonal();
+  return C;
+}
+
+// The rotation's determination, from the marginals: none (singular) with fixes on a line, or a
+// median sigma about some axis above config.max_rotation_sigma_deg, is said in `undetermined`.
+void judge_rotation(PoseGraphResult& out, int spread_axes, const PoseGraphConfig& config) {
+  const char* along_line =
+      "The fixes lie on a line: the rotation about it moves no antenna position. A turn, or a "
+      "lateral move, settles it.";
+  if (out.covariance.empty()) {
+    if (spread_axes == 1) {
+      out.undetermined.push_back({"the rotation about the line of the fixes", along_line});
+    }
+    return;
+  }
+  // The largest rotation sigma of each pose and its axis; their median.
+  std::vector<std::pair<double, Eigen::Vector3d>> weakest;
+  for (const Matrix6d& c : out.covariance) {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> e(c.topLeftCorner<3, 3>());
+    weakest.emplace_back(std::sqrt(std::max(e.eigenvalues()(2), 0.0)), e.eigenvectors().col(2));
+  }
+  std::nth_element(weakest.begin(), weakest.begin() + std::ptrdiff_t(weakest.size() / 2),
+                   weakest.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  const auto& [sigma, axis] = weakest[weakest.size() / 2];
+  const double sigma_deg = sigma * 180.0 / M_PI;
+  if (!(sigma_deg <= config.max_rotation_sigma_deg)) {
+    const Eigen::Vector3d a = axis.z() < 0 ? Eigen::Vector3d(-axis) : axis;
+    out.undetermined.push_back(
+        {fmt::format("the rotation about ENU ({:.2f}, {:.2f}, {:.2f})", a.x(), a.y(), a.z()),
+         fmt::format("its sigma is {:.2g} deg (the median over the poses; at most {} deg asked). "
+                     "{}",
+                     sigma_deg, config.max_rotation_sigma_deg,
+                     spread_axes == 1 ? along_line
+                                      : "The path and the fixes' accuracy do not fix it better.")});
+  }
+}
+
+}  // namespace
+
+std::string_view to_string(FixQuality quality) {
+  switch (quality) {
+    case FixQuality::rtk_fixed:
+      return "rtk_fixed";
+    case FixQuality::rtk_float:
+      return "rtk_float";
+    case FixQuality::single:
+      return "single";
+  }
+  return "?";
+}
+
+std::vector<PositionFix> position_fixes(const Trajectory& T_enu_gnss,
+                                        const std::vector<Eigen::Vector3d>& std_enu_m,
+                                        const std::vector<int>& status, double time_offset_s,
+                                        const PoseGraphConfig& config) {
+  if (!std_enu_m.empty() && std_enu_m.size() != T_enu_gnss.size())
+    throw Error(
+        fmt::format("{} standard deviations for {} fixes", std_enu_m.size(), T_enu_gnss.size()));
+  if (!status.empty() && status.size() != T_enu_gnss.size())
+    throw Error(fmt::format("{} fix states for {} fixes", status.size(), T_enu_gnss.size()));
+  std::vector<PositionFix> out;
+  out.reserve(T_enu_gnss.size());
+  const Time offset = Time::from_seconds(time_offset_s);
+  for (size_t i = 0; i < T_enu_gnss.size(); ++i) {
+    if (!status.empty() && status[i] < 0) continue;  // no fix
+    PositionFix f;
+    f.stamp = T_enu_gnss.stamps[i] + offset;
+    f.p_enu = T_enu_gnss.T_world_body[i].t;
+    f.quality = status.empty() || status[i] == 2 ? FixQuality::rtk_fixed : FixQuality::single;
+    // A receiver that does not know its accuracy reports zeros (NavSatFix's covariance type
+    // unknown): its state's sigmas then.
+    if (!std_enu_m.empty() && std_enu_m[i].minCoeff() > 0) {
+      f.covariance = std_enu_m[i].cwiseProduct(std_enu_m[i]).asDiagonal();
+    } else {
+      f.covariance = covariance_of(f.quality == FixQuality::rtk_fixed ? config.sigma_rtk_fixed
+                                                                      : config.sigma_single);
+    }
+    out.push_back(f);
+  }
+  return out;
+}
+
+std::vector<Matrix6d> chain_marginals(const std::vector<Matrix6d>& D,
+                                      const std::vector<Matrix6d>& B) {
+  const size_t n = D.size();
+  if (n == 0) return {};
+  // Forward: S_k = D_k - B_{k-1}' S_{k-1}^-1 B_{k-1}; backward (as a smoother):
+  // C_k = S_k^-1 + G_k C_{k+1} G_k', G_k = S_k^-1 B_k.
+  std::vector<Matrix6d> S_inv(n);
+  Matrix6d S = D[0];
+  for (size_t k = 0;; ++k) {
+    const Eigen::LDLT<Matrix6d> ldlt(S);
+    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0)) return {};
+    S_inv[k] = ldlt.solve(Matrix6d::Identity());
+    if (k + 1 == n) break;
+    S = D[k + 1] - B[k].transpose() * S_inv[k] * B[k];
+  }
+  std::vector<Matrix6d> C(n);
+  C[n - 1] = S_inv[n - 1];
+  for (size_t k = n - 1; k-- > 0;) {
+    const Matrix6d G = S_inv[k] * B[k];
+    C[k] = S_inv[k] + G * C[k + 1] * G.transpose();
+    C[k] = 0.5 * (C[k] + C[k].transpose()).eval();
+  }
+  for (const Matrix6d& c : C)
+    if (!c.allFinite()) return {};
+  return C;
+}
+
+PoseGraphResult solve_pose_graph(const OdometryInput& odometry,
+                                 const std::vector<PositionFix>& fixes,
+                                 const Eigen::Vector3d& p_lidar_antenna,
+                                 const PoseGraphConfig& config) {
+  const Trajectory& scans = odometry.T_odom_lidar;
+  const size_t n = scans.size();
+  if (n == 0) throw Error("the odometry has no poses");
+  if (odometry.step_covariance.size() + 1 != n) {
+    throw Error(fmt::format("{} step covariances for {} odometry poses ({} expected)",
+                            odometry.step_covariance.size(), n, n - 1));
+  }
+  PoseGraphResult out;
+  std::vector<bool> fix_used;
+  const std::vector<Prior> priors = priors_at_scans(scans, fixes, config, fix_used);
+  out.fixes_unused = size_t(std::count(fix_used.begin(), fix_used.end(), false));
+  if (priors.empty()) {
+    out.undetermined.push_back(
+        {"every pose", fixes.empty() ? "there is no GNSS fix"
+                                     : "no GNSS fix falls within the scans' time (check the "
+                                       "clocks and the GNSS time_offset)"});
+    return out;
+  }
+  // The spans of scans without a prior, longer than the interpolation gap.
+  {
+    Time last = scans.stamps.front();
+    bool open = true;  // from the first scan
+    size_t j = 0;
+    for (size_t k = 0; k < n; ++k) {
+      const bool has = j < priors.size() && priors[j].node == k;
+      if (has) ++j;
+      if (has) {
+        if (open && scans.stamps[k] - last > Time::from_seconds(config.max_fix_gap_s))
+          out.outages.emplace_back(last, scans.stamps[k]);
+        open = false;
+        last = scans.stamps[k];
+      } else {
+        open = true;
+      }
+    }
+    if (open && scans.stamps.back() - last > Time::from_seconds(config.max_fix_gap_s))
+      out.outages.emplace_back(last, scans.stamps.back());
+  }
+
+  // The starting guess: the odometry moved onto the fixes.
+  std::vector<Eigen::Vector3d> p_odom, p_enu;
+  for (const Prior& p : priors) {
+    p_odom.push_back(scans.T_world_body[p.node] * p_lidar_antenna);
+    p_enu.push_back(p.p_enu);
+  }
+  int spread_axes = 0;
+  const SE3 T_enu_odom = initial_alignment(p_odom, p_enu, config.min_spread_m, spread_axes);
+  // A standing rig: its rotation is the odometry's, held. Fixes along a line: solved, and the
+  // rotation about the line judged by its marginal sigma below.
+  const bool hold_rotation = spread_axes == 0;
+  if (spread_axes == 0) {
+    out.undetermined.push_back(
+        {"the rotation (heading, roll and pitch)",
+         fmt::format("the fixes spread less than {} m: the rig stood still; the odometry's "
+                     "rotation is kept. Move the rig over a few metres in two directions.",
+                     config.min_spread_m)});
+  }
+  // Priors closer in time than the fixes' correlation share their error: counted once.
+  double prior_scale = 1.0;
+  if (config.fix_correlation_s > 0 && n >= 2) {
+    const double scan_rate = double(n - 1) / (scans.stamps.back() - scans.stamps.front()).seconds();
+    prior_scale = std::max(1.0, config.fix_correlation_s * scan_rate);
+  }
+
+  out.priors.resize(priors.size());
+  for (size_t j = 0; j < priors.size(); ++j) {
+    out.priors[j].fix = priors[j].fix;
+    out.priors[j].node = priors[j].node;
+    out.priors[j].stamp = scans.stamps[priors[j].node];
+  }
+  std::vector<PoseBlock> poses(n);
+  for (size_t k = 0; k < n; ++k) {
+    const SE3 T_enu_lidar = T_enu_odom * scans.T_world_body[k];
+    poses[k] = {T_enu_lidar.quaternion(), T_enu_lidar.t};
+  }
+  // Solve 1, robust; the gate; solve 2 on the priors kept, from solve 1's poses.
+  for (int pass = 0; pass < 2; ++pass) {
+    Graph g;
+    g.poses = poses;
+    build(g, odometry, priors, out.priors, p_lidar_antenna, pass == 0 ? config.robust_sigmas : 0,
+          prior_scale, hold_rotation);
+    const ceres::Solver::Summary summary = solve(g, config.max_iterations);
+    if (!summary.IsSolutionUsable())
+      throw Error("the pose graph's solve failed: " + summary.message);
+    out.iterations += int(summary.iterations.size());
+    if (pass == 0) out.initial_cost = summary.initial_cost;
+    out.final_cost = summary.final_cost;
+    poses = g.poses;
+    for (size_t j = 0; j < priors.size(); ++j) {
+      PriorResidual& r = out.priors[j];
+      const PoseBlock& b = poses[priors[j].node];
+      r.residual_enu = b.q * p_lidar_antenna + b.t - priors[j].p_enu;
+      // Against the fix's own covariance (not the correlation-scaled weight).
+      r.mahalanobis2 = r.residual_enu.dot(priors[j].covariance.ldlt().solve(r.residual_enu));
+      if (pass == 0) r.rejected = r.mahalanobis2 > config.gate_chi2;
+    }
+    if (pass == 1 && !hold_rotation) out.covariance = pose_covariances(g);
+  }
+  if (!hold_rotation) judge_rotation(out, spread_axes, config);
+  if (!config.covariances) out.covariance.clear();
+  out.rejected = size_t(std::count_if(out.priors.begin(), out.priors.end(),
+                                      [](const PriorResidual& r) { return r.rejected; }));
+  out.T_enu_lidar.stamps = scans.stamps;
+  out.T_enu_lidar.has_stamps = scans.has_stamps;
+  for (const PoseBlock& b : poses)
+    out.T_enu_lidar.T_world_body.push_back(SE3::from_quaternion(b.q, b.t));
+  if (config.covariances && out.covariance.empty()) {
+    out.notes.push_back(hold_rotation || spread_axes == 1
+                            ? "no pose covariances: the rotation is not determined"
+                            : "no pose covariances: the graph's information is singular");
+  }
+  return out;
+}
+
+}  // namespace rigcal::gt

@@ -1,0 +1,65 @@
+#pragma once
+// Stage 1 of the ground truth (doc/ground-truth.md): a pose graph over the scan poses, the
+// odometry's relative motions weighted by its step covariances, GNSS position priors weighted by
+// the fixes' covariances (the paper's eq. 1). Ceres builds and solves it in the shape of its
+// pose_graph_3d example; a robust first solve, a chi-square gate on every prior, a second solve
+// on the priors kept, and each pose's marginal covariance.
+#include <Eigen/Core>
+#include <vector>
+
+#include "rigcal/gt/types.h"
+
+namespace rigcal::gt {
+
+struct PoseGraphConfig {
+  // A prior at a scan from the two fixes around its stamp, when they are at most this far apart.
+  double max_fix_gap_s = 0.5;
+  // Huber scale of the first solve, in sigmas of the prior.
+  double robust_sigmas = 3.0;
+  // A prior whose squared normalized residual exceeds this after the first solve is rejected:
+  // 16.27, the 99.9 % point of chi-square with 3 degrees of freedom.
+  double gate_chi2 = 16.27;
+  // Sigmas (horizontal, vertical; m) of a fix whose receiver reports none, by its quality.
+  Eigen::Vector2d sigma_rtk_fixed{0.02, 0.03}, sigma_rtk_float{0.3, 0.5}, sigma_single{2.0, 4.0};
+  // RTK errors drift over seconds: priors closer than this in time share their error, and each
+  // prior's covariance is multiplied by how many scans fall in this time (at least 1), so that
+  // a second of priors counts as one. 0: the fixes' errors taken as independent.
+  double fix_correlation_s = 0.0;
+  // The fixes' spread (m, standard deviation) below which they are taken as a point (a
+  // standing rig: no heading, the odometry's rotation held) or a line (the start rotation
+  // from the line's direction; the roll about it judged by max_rotation_sigma_deg).
+  double min_spread_m = 2.0;
+  // The rotation (about its weakest axis, the median over the poses) counts as undetermined
+  // when its marginal sigma is above this, deg: a near-straight path leaves the rotation about
+  // it to the lever arm and the path's small bends.
+  double max_rotation_sigma_deg = 1.0;
+  int max_iterations = 100;
+  bool covariances = true;
+};
+
+// Fixes from a GNSS/INS trajectory (its positions: the antenna or the INS frame's origin, ENU)
+// on its own clock: stamps moved to the base clock by `time_offset_s`; covariances from the
+// receiver's standard deviations (`std_enu_m`, one a fix, or empty; zeros: not known) or else from
+// the fix's quality (`status`, NavSatFix's, one a fix or empty: 2 RTK fixed, 0 and 1 single, -1 no
+// fix, left out), `rtk_fixed` when neither is given.
+std::vector<PositionFix> position_fixes(const Trajectory& T_enu_gnss,
+                                        const std::vector<Eigen::Vector3d>& std_enu_m,
+                                        const std::vector<int>& status, double time_offset_s,
+                                        const PoseGraphConfig& config);
+
+// The scan poses in the fixes' ENU frame. `p_lidar_antenna`: the antenna (the fixes' point) in
+// the LiDAR frame. Nothing throws on data that fix too little: the result says what is
+// undetermined (no prior at all: no pose; a standing rig: the rotation held at the odometry's;
+// a rotation sigma above max_rotation_sigma_deg, or none on a line: said, the poses kept).
+PoseGraphResult solve_pose_graph(const OdometryInput& odometry,
+                                 const std::vector<PositionFix>& fixes,
+                                 const Eigen::Vector3d& p_lidar_antenna,
+                                 const PoseGraphConfig& config);
+
+// The marginal covariance of every pose of a chain: H block tridiagonal (pose k tied to k - 1 and
+// k + 1 only), given by its diagonal blocks D (n of them) and the blocks B[k] = H(k, k + 1)
+// (n - 1). O(n); none when H is singular.
+std::vector<Matrix6d> chain_marginals(const std::vector<Matrix6d>& D,
+                                      const std::vector<Matrix6d>& B);
+
+}  // namespace rigcal::gt

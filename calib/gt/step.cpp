@@ -1,0 +1,210 @@
+#include "rigcal/gt/step.h"
+
+#include <fmt/format.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <unordered_map>
+
+#include "rigcal/core/error.h"
+#include "rigcal/core/stats.h"
+#include "rigcal/core/text.h"
+#include "rigcal/core/version.h"
+#include "rigcal/io/trajectory_io.h"
+
+namespace rigcal::gt {
+namespace fs = std::filesystem;
+
+namespace {
+
+// The GNSS sensor's stamps on the base clock: its offset, and its drift where the rig has one.
+Trajectory on_base_clock(Trajectory T_enu_gnss, const rig::Sensor& gnss) {
+  for (Time& t : T_enu_gnss.stamps) {
+    double s = gnss.time_offset;
+    if (gnss.time_drift_ppm)
+      s += *gnss.time_drift_ppm * 1e-6 * (t - gnss.time_drift_epoch).seconds();
+    t = t + Time::from_seconds(s);
+  }
+  return T_enu_gnss;
+}
+
+nlohmann::json vector_json(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+}  // namespace
+
+std::vector<Matrix6d> covariances_of_steps(const Trajectory& T_odom_lidar,
+                                           const std::vector<io::StepCovariance>& steps,
+                                           const std::string& source) {
+  std::unordered_map<int64_t, const io::StepCovariance*> by_prev;
+  for (const io::StepCovariance& s : steps) by_prev[s.prev.ns] = &s;
+  std::vector<Matrix6d> out;
+  for (size_t k = 0; k + 1 < T_odom_lidar.size(); ++k) {
+    const auto it = by_prev.find(T_odom_lidar.stamps[k].ns);
+    if (it == by_prev.end() || it->second->cur != T_odom_lidar.stamps[k + 1]) {
+      throw Error(fmt::format(
+          "{}: no covariance for the step from {} s to {} s of the odometry (the covariances of "
+          "another run?)",
+          source, to_seconds_text(T_odom_lidar.stamps[k]),
+          to_seconds_text(T_odom_lidar.stamps[k + 1])));
+    }
+    out.push_back(it->second->covariance);
+  }
+  return out;
+}
+
+GroundTruthRun run_ground_truth(const StepInputs& in, const StepOptions& o,
+                                const report::Progress& progress) {
+  const auto started = std::chrono::steady_clock::now();
+  GroundTruthRun run;
+  const rig::Sensor* gnss = rig::find_sensor(in.rig, o.gnss_sensor);
+  const rig::Sensor* lidar = rig::find_sensor(in.rig, o.lidar_sensor);
+  if (!gnss)
+    throw Error(
+        fmt::format("--gnss-sensor {}: no such sensor in {}", o.gnss_sensor, in.rig_source));
+  if (!lidar)
+    throw Error(
+        fmt::format("--lidar-sensor {}: no such sensor in {}", o.lidar_sensor, in.rig_source));
+  run.p_lidar_antenna = (lidar->T_base_sensor.inverse() * gnss->T_base_sensor).t;
+
+  // The odometry: a file and its covariances, or rigcal's run.
+  OdometryInput odometry;
+  if (!in.odometry.empty()) {
+    const fs::path covariances =
+        in.covariances.empty()
+            ? fs::path(fs::path(in.odometry).replace_extension("").string() + "_covariances.txt")
+            : in.covariances;
+    if (!fs::exists(covariances)) {
+      throw Error(fmt::format(
+          "{}: no step covariances (looked for {}): the pose graph weighs each step by its "
+          "covariance; give --covariances, or let rigcal's odometry run on the scans",
+          in.odometry.string(), covariances.string()));
+    }
+    report::tell(progress, "reading the odometry", 0, 1);
+    odometry.T_odom_lidar = io::read_trajectory(in.odometry).trajectory;
+    odometry.step_covariance = covariances_of_steps(
+        odometry.T_odom_lidar, io::read_step_covariances(covariances), covariances.string());
+    report::tell(progress, "reading the odometry", 1, 1);
+  } else {
+    if (in.scans.empty()) throw Error("no odometry and no scans: give one of them");
+    run.odometry_preset = lidar::choose_preset(o.odometry_preset, lidar, run.notes);
+    lidar::OdometryConfig config = lidar::odometry_preset(run.odometry_preset);
+    config.estimate_sweep_motion = o.odometry_sweep_motion;
+    run.odometry = lidar::run_odometry(in.scans, config, progress);
+    for (const std::string& n : run.odometry->notes) run.notes.push_back("odometry: " + n);
+    odometry.T_odom_lidar = run.odometry->T_odom_lidar;
+    odometry.step_covariance = covariances_of_steps(
+        odometry.T_odom_lidar, lidar::step_covariances(*run.odometry), "rigcal's odometry");
+  }
+  if (odometry.T_odom_lidar.size() < 2)
+    throw Error(
+        fmt::format("the odometry has {} poses: at least 2 needed", odometry.T_odom_lidar.size()));
+
+  // The fixes: positions, on the base clock.
+  report::tell(progress, "reading the GNSS", 0, 1);
+  if (io::is_gnss_fixes_file(in.gnss)) {
+    const io::GnssFixes f = io::read_gnss_fixes(in.gnss, std::nullopt);
+    run.origin = f.origin;
+    run.fixes = position_fixes(on_base_clock(f.T_enu_gnss, *gnss), f.std_enu_m, f.status, 0.0,
+                               o.pose_graph);
+    if (f.std_enu_m.empty()) {
+      run.notes.push_back(fmt::format(
+          "{} gives no standard deviations: every fix taken as {} (horizontal {} m, vertical {} m)",
+          in.gnss.string(), f.status.empty() ? "RTK fixed" : "its status says",
+          o.pose_graph.sigma_rtk_fixed.x(), o.pose_graph.sigma_rtk_fixed.y()));
+    }
+  } else {
+    const Trajectory T_enu_gnss = io::read_trajectory(in.gnss).trajectory;
+    run.fixes = position_fixes(on_base_clock(T_enu_gnss, *gnss), {}, {}, 0.0, o.pose_graph);
+    run.notes.push_back(fmt::format(
+        "{}: GNSS/INS poses without accuracies: their positions taken as RTK fixed (horizontal {} "
+        "m, vertical {} m); their attitude is not used",
+        in.gnss.string(), o.pose_graph.sigma_rtk_fixed.x(), o.pose_graph.sigma_rtk_fixed.y()));
+  }
+  report::tell(progress, "reading the GNSS", 1, 1);
+
+  report::tell(progress, "solving the pose graph", 0, 1);
+  run.graph = solve_pose_graph(odometry, run.fixes, run.p_lidar_antenna, o.pose_graph);
+  report::tell(progress, "solving the pose graph", 1, 1);
+  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return run;
+}
+
+nlohmann::json ground_truth_report(const GroundTruthRun& run, const StepInputs& in) {
+  const PoseGraphResult& g = run.graph;
+  nlohmann::json j;
+  j["tool"] = {{"name", "rigcal ground-truth"}, {"version", version_string()}};
+  j["inputs"] = {{"odometry", in.odometry.string()},
+                 {"scans", in.scans.string()},
+                 {"gnss", in.gnss.string()},
+                 {"rig", in.rig_source}};
+  if (run.odometry) j["inputs"]["odometry_preset"] = run.odometry_preset;
+  j["frame"] = run.origin ? nlohmann::json{{"enu_origin",
+                                            {{"latitude_deg", run.origin->latitude_deg},
+                                             {"longitude_deg", run.origin->longitude_deg},
+                                             {"height_m", run.origin->height_m}}}}
+                          : nlohmann::json{{"enu", "the GNSS/INS poses' frame"}};
+  j["lever_arm_m"] = vector_json(run.p_lidar_antenna);
+  // Residuals of the priors kept, horizontal and vertical; the poses' sigmas.
+  std::vector<double> horizontal, vertical, sigma_h, sigma_v, sigma_yaw;
+  for (const PriorResidual& p : g.priors) {
+    if (p.rejected) continue;
+    horizontal.push_back(p.residual_enu.head<2>().norm());
+    vertical.push_back(std::abs(p.residual_enu.z()));
+  }
+  for (const Matrix6d& c : g.covariance) {
+    sigma_h.push_back(std::sqrt(c(3, 3) + c(4, 4)));
+    sigma_v.push_back(std::sqrt(c(5, 5)));
+    sigma_yaw.push_back(std::sqrt(c(2, 2)) * 180.0 / M_PI);
+  }
+  auto stats = [](std::vector<double> v) {
+    if (v.empty()) return nlohmann::json();
+    const double max = *std::max_element(v.begin(), v.end());
+    return nlohmann::json{{"rms", rms(v)}, {"median", median(v)}, {"max", max}};
+  };
+  nlohmann::json outages = nlohmann::json::array();
+  for (const auto& [from, to] : g.outages) {
+    outages.push_back({{"from_s", to_seconds_text(from)},
+                       {"to_s", to_seconds_text(to)},
+                       {"duration_s", (to - from).seconds()}});
+  }
+  nlohmann::json undetermined = nlohmann::json::array();
+  for (const Undetermined& u : g.undetermined)
+    undetermined.push_back({{"what", u.what}, {"why", u.why}});
+  const size_t fixed =
+      size_t(std::count_if(run.fixes.begin(), run.fixes.end(), [](const PositionFix& f) {
+        return f.quality == FixQuality::rtk_fixed;
+      }));
+  j["summary"] = {{"poses", g.T_enu_lidar.size()},
+                  {"path_length_m", g.T_enu_lidar.empty() ? 0.0 : path_length(g.T_enu_lidar)},
+                  {"fixes", run.fixes.size()},
+                  {"fixes_rtk_fixed", fixed},
+                  {"fixes_unused", g.fixes_unused},
+                  {"priors", g.priors.size()},
+                  {"priors_rejected", g.rejected},
+                  {"outages", outages},
+                  {"undetermined", undetermined},
+                  {"prior_residual_horizontal_m", stats(horizontal)},
+                  {"prior_residual_vertical_m", stats(vertical)},
+                  {"pose_sigma_horizontal_m", stats(sigma_h)},
+                  {"pose_sigma_vertical_m", stats(sigma_v)},
+                  {"pose_sigma_yaw_deg", stats(sigma_yaw)},
+                  {"solver_iterations", g.iterations},
+                  {"seconds", run.seconds}};
+  j["notes"] = run.notes;
+  for (const std::string& n : g.notes) j["notes"].push_back(n);
+  nlohmann::json priors = nlohmann::json::array();
+  for (const PriorResidual& p : g.priors) {
+    priors.push_back({{"stamp_s", to_seconds_text(p.stamp)},
+                      {"pose", p.node},
+                      {"fix", p.fix},
+                      {"residual_enu_m", vector_json(p.residual_enu)},
+                      {"mahalanobis2", p.mahalanobis2},
+                      {"rejected", p.rejected}});
+  }
+  j["priors"] = std::move(priors);
+  return j;
+}
+
+}  // namespace rigcal::gt

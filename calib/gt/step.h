@@ -1,0 +1,68 @@
+#pragma once
+// The ground-truth step (doc/ground-truth.md): the LiDAR odometry (a file with its step
+// covariances, or rigcal's own run on the scans) and the GNSS fixes of a recording, through the
+// pose graph, into the LiDAR's trajectory in the fixes' local ENU frame with each pose's
+// covariance. Stage 1 of the paper's method; the LiDAR bundle adjustment (stage 2) is not built.
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rigcal/gt/pose_graph.h"
+#include "rigcal/io/gnss_fixes.h"
+#include "rigcal/lidar/step.h"
+#include "rigcal/report/step.h"
+#include "rigcal/rig/rig.h"
+
+namespace rigcal::gt {
+
+struct StepOptions {
+  std::string gnss_sensor = "gnss", lidar_sensor = "lidar";  // the rig's sensors
+  PoseGraphConfig pose_graph;
+  // rigcal's odometry, when it runs on StepInputs::scans (lidar::choose_preset).
+  std::string odometry_preset;
+  bool odometry_sweep_motion = false;
+};
+
+struct StepInputs {
+  // T_odom_lidar (any trajectory format) and its step covariances (rigcal odometry's text
+  // format; `covariances` empty: beside the odometry, its name without extension +
+  // _covariances.txt, what `rigcal odometry` writes).
+  std::filesystem::path odometry, covariances;
+  // Or, with `odometry` empty, the scans (as lidar::scans_folder gives): rigcal's odometry runs.
+  std::filesystem::path scans;
+  // GNSS/INS poses (T_enu_gnss; their positions are used) or a CSV of fixes (positions only).
+  std::filesystem::path gnss;
+  rig::Rig rig;  // the lever arm (the GNSS sensor's T_b) and its clock (time_offset)
+  std::string rig_source;
+};
+
+struct GroundTruthRun {
+  PoseGraphResult graph;
+  std::vector<PositionFix> fixes;
+  Eigen::Vector3d p_lidar_antenna = Eigen::Vector3d::Zero();
+  std::optional<io::GeodeticOrigin> origin;    // of the ENU frame, when the GNSS gave fixes
+  std::optional<lidar::OdometryRun> odometry;  // when rigcal's ran here
+  std::string odometry_preset;
+  std::vector<std::string> notes;
+  double seconds = 0;
+};
+
+// The step covariances of the trajectory's consecutive poses, matched by their stamps. Throws
+// rigcal::Error naming `source` and the first pose pair without one.
+std::vector<Matrix6d> covariances_of_steps(const Trajectory& T_odom_lidar,
+                                           const std::vector<io::StepCovariance>& steps,
+                                           const std::string& source);
+
+// Throws rigcal::Error on unreadable inputs, sensors missing from the rig, or odometry and
+// covariances that do not match; what the data cannot fix is in graph.undetermined.
+GroundTruthRun run_ground_truth(const StepInputs& inputs, const StepOptions& options,
+                                const report::Progress& progress = {});
+
+// The report: the inputs, a summary (poses, path, fixes, priors used and rejected, outages, what
+// is undetermined, the priors' residuals, the poses' sigmas) and one row a prior
+// (doc/ground-truth.md says what each number is).
+nlohmann::json ground_truth_report(const GroundTruthRun& run, const StepInputs& inputs);
+
+}  // namespace rigcal::gt

@@ -1,0 +1,68 @@
+#pragma once
+// The ground truth's inputs and outputs (doc/ground-truth.md): the odometry's scan poses and
+// relative motions with their covariances, GNSS position fixes with theirs, and the poses the
+// pose graph puts in the local ENU frame of the fixes, each with its covariance.
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rigcal/core/se3.h"
+#include "rigcal/core/time.h"
+#include "rigcal/core/trajectory.h"
+
+namespace rigcal::gt {
+
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+
+// What the receiver says of a fix. The sigmas a quality stands for when the receiver gives none
+// are PoseGraphConfig's.
+enum class FixQuality { rtk_fixed, rtk_float, single };
+std::string_view to_string(FixQuality quality);
+
+// A position of the GNSS antenna (or the INS frame's origin) in the local ENU frame, on the base
+// clock.
+struct PositionFix {
+  Time stamp;
+  Eigen::Vector3d p_enu = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // m^2, ENU
+  FixQuality quality = FixQuality::rtk_fixed;
+};
+
+// The scans' poses from the odometry, and each step's covariance: steps[k] is the motion from
+// pose k to pose k + 1, T_prev_cur = perturbed(truth, e) with e ~ N(0, covariance) (rigcal's
+// tangent: rotation first, left perturbation, in the previous sensor frame).
+struct OdometryInput {
+  Trajectory T_odom_lidar;
+  std::vector<Matrix6d> step_covariance;  // size() - 1 of them
+};
+
+// A fix's prior as the pose graph used it.
+struct PriorResidual {
+  size_t fix = 0;   // index into the fixes
+  size_t node = 0;  // the scan pose it constrains
+  Time stamp;
+  Eigen::Vector3d residual_enu = Eigen::Vector3d::Zero();  // antenna estimate - fix, m
+  double mahalanobis2 = 0;  // residual' covariance^-1 residual (chi-square with 3 dof)
+  bool rejected = false;
+};
+
+// What the data cannot fix, said in words (and the data that would).
+struct Undetermined {
+  std::string what, why;
+};
+
+struct PoseGraphResult {
+  Trajectory T_enu_lidar;
+  std::vector<Matrix6d> covariance;  // one a pose, rigcal's tangent in the ENU frame
+  std::vector<PriorResidual> priors;
+  size_t rejected = 0;
+  size_t fixes_unused = 0;                     // no scan within the interpolation gap
+  std::vector<std::pair<Time, Time>> outages;  // scan spans with no prior, longer than the gap
+  std::vector<Undetermined> undetermined;
+  std::vector<std::string> notes;
+  int iterations = 0;
+  double initial_cost = 0, final_cost = 0;
+};
+
+}  // namespace rigcal::gt

@@ -1,0 +1,545 @@
+// The ground truth's pose graph (calib/gt): odometry and GNSS priors from the simulator's
+// trajectories part, scored against its truth.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <Eigen/Dense>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <set>
+
+#include "cli_run.h"
+#include "rigcal/bench/metrics.h"
+#include "rigcal/core/error.h"
+#include "rigcal/core/stats.h"
+#include "rigcal/gt/pose_graph.h"
+#include "rigcal/io/gnss_fixes.h"
+#include "rigcal/io/odometry_io.h"
+#include "rigcal/io/trajectory_io.h"
+#include "rigcal/rig/rig_yaml.h"
+#include "rigcal/sim/session.h"
+
+namespace rigcal {
+namespace {
+
+using gt::Matrix6d;
+
+// The simulator's odometry noise as a step covariance (its scale error is a bias, left out).
+Matrix6d step_covariance(const sim::OdometryNoise& noise) {
+  const double r = noise.rot_sigma_deg * M_PI / 180.0, t = noise.trans_sigma_m;
+  return (Vector6d() << r * r, r * r, r * r, t * t, t * t, t * t).finished().asDiagonal();
+}
+
+struct Scenario {
+  rig::Rig rig = rig::read_rig_file(RIGCAL_SOURCE_DIR "/data/sample_rig.yaml");
+  sim::SimConfig config;
+  sim::TrajectoryPart part;
+  Eigen::Vector3d p_lidar_antenna;
+  std::vector<gt::PositionFix> fixes;
+  gt::OdometryInput odometry;
+  Trajectory truth_enu;  // T_enu_lidar
+
+  void simulate() {
+    part = sim::simulate_trajectories(rig, config);
+    const rig::Sensor& gnss = rig::sensor(rig, "gnss");
+    p_lidar_antenna = gnss.T_base_sensor.t;  // the LiDAR is the base frame
+    fixes = gt::position_fixes(part.gnss, {}, {}, gnss.time_offset, gt::PoseGraphConfig{});
+    odometry.T_odom_lidar = part.odometry;
+    odometry.step_covariance.assign(part.odometry.size() - 1, step_covariance(config.odometry));
+    truth_enu = part.truth_base;
+    for (SE3& T : truth_enu.T_world_body) T = part.T_enu_world * T;
+  }
+};
+
+// Relative translation error over pairs about `length_m` of path apart: the displacement in the
+// first pose's frame (estimate and truth), or in ENU when `enu` (positions without rotation).
+double relative_error_rms(const std::vector<SE3>& est, const std::vector<SE3>& truth,
+                          double length_m, bool enu) {
+  std::vector<double> along(truth.size(), 0.0), errors;
+  for (size_t k = 1; k < truth.size(); ++k)
+    along[k] = along[k - 1] + (truth[k].t - truth[k - 1].t).norm();
+  size_t j = 0;
+  for (size_t i = 0; i < truth.size(); i += 5) {
+    while (j < truth.size() && along[j] - along[i] < length_m) ++j;
+    if (j >= truth.size()) break;
+    const Eigen::Vector3d d_est =
+        enu ? Eigen::Vector3d(est[j].t - est[i].t) : Eigen::Vector3d((est[i].inverse() * est[j]).t);
+    const Eigen::Vector3d d_true = enu ? Eigen::Vector3d(truth[j].t - truth[i].t)
+                                       : Eigen::Vector3d((truth[i].inverse() * truth[j]).t);
+    errors.push_back((d_est - d_true).norm());
+  }
+  return rms(errors);
+}
+
+// H block tridiagonal, random and positive definite: the chain's marginals against the dense
+// inverse.
+TEST(PoseGraph, ChainMarginalsAreTheDiagonalBlocksOfTheInverse) {
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> N;
+  const size_t n = 9;
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(12 * n, 6 * n);
+  for (size_t k = 0; k < n; ++k) {  // a prior on each pose and an edge to the next
+    for (int r = 0; r < 6; ++r)
+      for (int c = 0; c < 6; ++c) J(12 * k + r, 6 * k + c) = N(rng);
+    if (k + 1 == n) continue;
+    for (int r = 6; r < 12; ++r)
+      for (int c = 0; c < 12; ++c) J(12 * k + r, 6 * k + c) = N(rng);
+  }
+  const Eigen::MatrixXd H = J.transpose() * J;
+  std::vector<Matrix6d> D(n), B(n - 1);
+  for (size_t k = 0; k < n; ++k) {
+    D[k] = H.block<6, 6>(6 * k, 6 * k);
+    if (k + 1 < n) B[k] = H.block<6, 6>(6 * k, 6 * k + 6);
+  }
+  const Eigen::MatrixXd H_inv = H.inverse();
+  const std::vector<Matrix6d> C = gt::chain_marginals(D, B);
+  ASSERT_EQ(C.size(), n);
+  for (size_t k = 0; k < n; ++k) {
+    const Matrix6d expected = H_inv.block<6, 6>(6 * k, 6 * k);
+    EXPECT_LT((C[k] - expected).norm(), 1e-9 * expected.norm()) << k;
+  }
+  D[4].setZero();  // a pose nothing ties: no marginals
+  B[3].setZero(), B[4].setZero();
+  EXPECT_TRUE(gt::chain_marginals(D, B).empty());
+}
+
+// A two-minute walk with RTK fixes at 100 Hz, 1 % multipath outliers and a 20 s outage.
+TEST(PoseGraph, AWalkWithRtkFixesBeatsTheOdometryAndTheGnssAloneAndItsSigmasAreHonest) {
+  Scenario s;
+  s.config.trajectory_duration_s = 120;
+  s.config.gnss.outages = {{40.0, 60.0}};
+  s.config.gnss.outlier_probability = 0.01;
+  s.simulate();
+  const gt::PoseGraphResult r =
+      gt::solve_pose_graph(s.odometry, s.fixes, s.p_lidar_antenna, gt::PoseGraphConfig{});
+  ASSERT_EQ(r.T_enu_lidar.size(), s.truth_enu.size());
+  ASSERT_EQ(r.covariance.size(), s.truth_enu.size());
+  EXPECT_TRUE(r.undetermined.empty());
+  const std::vector<SE3>&est = r.T_enu_lidar.T_world_body, &truth = s.truth_enu.T_world_body;
+
+  // Absolute errors, in the outage and out of it, with their normalized squares.
+  std::vector<double> errors, outage_errors;
+  size_t within = 0, rot_within = 0;
+  for (size_t k = 0; k < truth.size(); ++k) {
+    const Eigen::Vector3d e = est[k].t - truth[k].t;
+    const double t = (s.truth_enu.stamps[k] - s.truth_enu.stamps.front()).seconds();
+    (t >= 40.0 && t < 60.0 ? outage_errors : errors).push_back(e.norm());
+    const Eigen::Matrix3d C = r.covariance[k].bottomRightCorner<3, 3>();
+    within += e.dot(C.ldlt().solve(e)) <= 14.16;  // 99.73 % of chi-square(3)
+    const Eigen::Vector3d e_rot = rotation_vector(est[k].R * truth[k].R.transpose());
+    rot_within += e_rot.dot(r.covariance[k].topLeftCorner<3, 3>().ldlt().solve(e_rot)) <= 14.16;
+  }
+  std::vector<double> all = errors;
+  all.insert(all.end(), outage_errors.begin(), outage_errors.end());
+  // The odometry alone, aligned to the truth; the GNSS alone, at the scans.
+  std::vector<double> odom_errors;
+  {
+    const bench::AlignmentResult a =
+        bench::align(truth, s.odometry.T_odom_lidar.T_world_body, bench::Alignment::se3);
+    for (size_t k = 0; k < truth.size(); ++k)
+      odom_errors.push_back(
+          (bench::apply(a, s.odometry.T_odom_lidar.T_world_body[k]).t - truth[k].t).norm());
+  }
+  // The GNSS alone, its multipath fixes (off by more than 0.3 m) left out: the honest bar.
+  std::vector<SE3> gnss_at_scans, truth_at_fixes;
+  std::vector<double> gnss_errors;
+  for (const gt::PriorResidual& p : r.priors) {
+    SE3 T;
+    T.t = s.fixes[p.fix].p_enu - truth[p.node].R * s.p_lidar_antenna;
+    const double e = (T.t - truth[p.node].t).norm();
+    if (e >= 0.3) continue;
+    gnss_at_scans.push_back(T);
+    truth_at_fixes.push_back(truth[p.node]);
+    gnss_errors.push_back(e);
+  }
+  const double rpe_graph = relative_error_rms(est, truth, 10.0, false);
+  const double rpe_odom =
+      relative_error_rms(s.odometry.T_odom_lidar.T_world_body, truth, 10.0, false);
+  const double rpe_gnss = relative_error_rms(gnss_at_scans, truth_at_fixes, 10.0, true);
+  std::printf(
+      "[ figures ] pose graph, 120 s walk (%.0f m), 20 s outage: ATE rms %.1f mm (max %.1f; in the "
+      "outage rms %.1f, max %.1f); odometry alone (aligned) rms %.1f mm; GNSS alone (no multipath "
+      "fix) rms %.1f mm. "
+      "RPE over 10 m: graph %.1f, odometry %.1f, GNSS %.1f mm. Poses within 3 sigma: position "
+      "%.1f %%, rotation %.1f %%; priors rejected %zu of %zu\n",
+      path_length(s.truth_enu), 1e3 * rms(errors), 1e3 * *std::max_element(all.begin(), all.end()),
+      1e3 * rms(outage_errors), 1e3 * *std::max_element(outage_errors.begin(), outage_errors.end()),
+      1e3 * rms(odom_errors), 1e3 * rms(gnss_errors), 1e3 * rpe_graph, 1e3 * rpe_odom,
+      1e3 * rpe_gnss, 100.0 * within / truth.size(), 100.0 * rot_within / truth.size(), r.rejected,
+      r.priors.size());
+  EXPECT_LT(rms(all), rms(odom_errors));
+  EXPECT_LT(rms(errors), rms(gnss_errors));
+  EXPECT_LT(rpe_graph, rpe_odom);
+  EXPECT_LT(rpe_graph, rpe_gnss);
+  EXPECT_GE(double(within), 0.95 * double(truth.size()));
+  EXPECT_GE(double(rot_within), 0.95 * double(truth.size()));
+  // The outage is listed; the priors off by multipath are rejected, nearly no others.
+  ASSERT_EQ(r.outages.size(), 1u);
+  EXPECT_NEAR((r.outages[0].first - s.truth_enu.stamps.front()).seconds(), 40.0, 0.2);
+  EXPECT_NEAR((r.outages[0].second - s.truth_enu.stamps.front()).seconds(), 60.0, 0.2);
+  size_t off = 0, off_rejected = 0, good_rejected = 0;
+  for (const gt::PriorResidual& p : r.priors) {
+    const Eigen::Vector3d truth_antenna = truth[p.node] * s.p_lidar_antenna;
+    const bool is_off = (s.fixes[p.fix].p_enu - truth_antenna).norm() > 0.3;
+    off += is_off, off_rejected += is_off && p.rejected, good_rejected += !is_off && p.rejected;
+  }
+  EXPECT_GT(off, 3u);
+  EXPECT_EQ(off_rejected, off);
+  EXPECT_LE(double(good_rejected), 0.01 * double(r.priors.size()));
+}
+
+// A truth trajectory's odometry and fixes, made here: steps perturbed by `step_sigma` (rotation
+// rad, translation m; rigcal's tangent) and chained from an arbitrary odometry frame; fixes of
+// the antenna at every scan with `fix_sigma_m` noise, kept where `has_fix` says.
+struct Synthetic {
+  Trajectory truth;  // T_enu_lidar
+  Eigen::Vector3d p_lidar_antenna{0.1, -0.05, 0.3};
+  gt::OdometryInput odometry;
+  std::vector<gt::PositionFix> fixes;
+
+  void make(double step_rot, double step_trans, double fix_sigma_m,
+            const std::function<bool(double)>& has_fix, uint64_t seed = 1) {
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<double> N;
+    const Vector6d sigma =
+        (Vector6d() << step_rot, step_rot, step_rot, step_trans, step_trans, step_trans).finished();
+    const Matrix6d C = sigma.cwiseProduct(sigma).asDiagonal();
+    odometry.T_odom_lidar.stamps = truth.stamps;
+    odometry.T_odom_lidar.T_world_body = {
+        SE3::from_rotation_vector(Eigen::Vector3d(0.02, -0.01, 1.0), Eigen::Vector3d(5, -3, 1))};
+    for (size_t k = 0; k + 1 < truth.size(); ++k) {
+      Vector6d e;
+      for (int i = 0; i < 6; ++i) e(i) = sigma(i) * N(rng);
+      const SE3 step = perturbed(truth.T_world_body[k].inverse() * truth.T_world_body[k + 1], e);
+      odometry.T_odom_lidar.T_world_body.push_back(odometry.T_odom_lidar.T_world_body.back() *
+                                                   step);
+      odometry.step_covariance.push_back(C);
+    }
+    for (size_t k = 0; k < truth.size(); ++k) {
+      const double t = (truth.stamps[k] - truth.stamps.front()).seconds();
+      if (!has_fix(t)) continue;
+      gt::PositionFix f;
+      f.stamp = truth.stamps[k];
+      f.p_enu = truth.T_world_body[k] * p_lidar_antenna +
+                fix_sigma_m * Eigen::Vector3d(N(rng), N(rng), N(rng));
+      f.covariance = fix_sigma_m * fix_sigma_m * Eigen::Matrix3d::Identity();
+      fixes.push_back(f);
+    }
+  }
+};
+
+// `seconds` at 10 Hz of T_enu_lidar(t).
+Trajectory truth_of(double seconds, const std::function<SE3(double)>& T_enu_lidar) {
+  Trajectory out;
+  for (int k = 0; k <= int(std::lround(10 * seconds)); ++k) {
+    out.stamps.push_back(Time::from_seconds(1000.0 + 0.1 * k));
+    out.T_world_body.push_back(T_enu_lidar(0.1 * k));
+  }
+  return out;
+}
+
+// A loop of 10 m radius, one lap a minute, heading along the loop.
+SE3 on_a_loop(double t) {
+  const double a = 2 * M_PI * t / 60.0;
+  return SE3::from_rotation_vector(
+      Eigen::Vector3d(0, 0, a + M_PI / 2),
+      Eigen::Vector3d(10 * std::cos(a), 10 * std::sin(a), 0.1 * std::sin(3 * a)));
+}
+
+TEST(PoseGraph, NoFixAtAllPlacesNoPoseAndSaysWhy) {
+  Synthetic s;
+  s.truth = truth_of(10, on_a_loop);
+  s.make(1e-4, 2e-3, 0.02, [](double) { return false; });
+  const gt::PoseGraphResult none =
+      gt::solve_pose_graph(s.odometry, s.fixes, s.p_lidar_antenna, gt::PoseGraphConfig{});
+  EXPECT_TRUE(none.T_enu_lidar.empty());
+  ASSERT_EQ(none.undetermined.size(), 1u);
+  EXPECT_EQ(none.undetermined[0].what, "every pose");
+  EXPECT_NE(none.undetermined[0].why.find("no GNSS fix"), std::string::npos);
+  // Fixes an hour away (a wrong clock offset): said so, with the clock named.
+  std::vector<gt::PositionFix> late = {gt::PositionFix{}, gt::PositionFix{}};
+  late[0].stamp = s.truth.stamps.back() + Time::from_seconds(3600);
+  late[1].stamp = late[0].stamp + Time::from_seconds(0.1);
+  const gt::PoseGraphResult off =
+      gt::solve_pose_graph(s.odometry, late, s.p_lidar_antenna, gt::PoseGraphConfig{});
+  EXPECT_TRUE(off.T_enu_lidar.empty());
+  ASSERT_EQ(off.undetermined.size(), 1u);
+  EXPECT_NE(off.undetermined[0].why.find("time_offset"), std::string::npos);
+  EXPECT_EQ(off.fixes_unused, 2u);
+}
+
+TEST(PoseGraph, ARigStandingStillHasItsPositionButNoHeading) {
+  Synthetic s;
+  s.truth = truth_of(30, [](double) {
+    return SE3::from_rotation_vector(Eigen::Vector3d(0, 0, 2.0), Eigen::Vector3d(3, 4, 0.5));
+  });
+  s.make(1e-4, 1e-3, 0.02, [](double) { return true; });
+  const gt::PoseGraphResult r =
+      gt::solve_pose_graph(s.odometry, s.fixes, s.p_lidar_antenna, gt::PoseGraphConfig{});
+  ASSERT_EQ(r.T_enu_lidar.size(), s.truth.size());
+  ASSERT_EQ(r.undetermined.size(), 1u);
+  EXPECT_NE(r.undetermined[0].what.find("heading"), std::string::npos);
+  EXPECT_TRUE(r.covariance.empty());  // no sigmas invented for a rotation nothing fixes
+  ASSERT_EQ(r.notes.size(), 1u);
+  EXPECT_NE(r.notes[0].find("not determined"), std::string::npos);
+  // The antenna is where the fixes put it (301 fixes of 2 cm: their mean to about 1.2 mm).
+  for (size_t k = 0; k < s.truth.size(); k += 50) {
+    const Eigen::Vector3d e = r.T_enu_lidar.T_world_body[k] * s.p_lidar_antenna -
+                              s.truth.T_world_body[k] * s.p_lidar_antenna;
+    EXPECT_LT(e.norm(), 0.01) << k;
+  }
+}
+
+TEST(PoseGraph, AStraightLineLeavesOnlyTheRollAboutItUndetermined) {
+  Synthetic s;
+  s.truth = truth_of(20, [](double t) {
+    return SE3::from_rotation_vector(Eigen::Vector3d(0, 0, 0.5),
+                                     Eigen::Vector3d(std::cos(0.5) * t, std::sin(0.5) * t, 0));
+  });
+  s.make(1e-4, 1e-3, 0.02, [](double) { return true; });
+  const gt::PoseGraphResult r =
+      gt::solve_pose_graph(s.odometry, s.fixes, s.p_lidar_antenna, gt::PoseGraphConfig{});
+  ASSERT_EQ(r.T_enu_lidar.size(), s.truth.size());
+  ASSERT_EQ(r.undetermined.size(), 1u);
+  EXPECT_NE(r.undetermined[0].what.find("rotation about"), std::string::npos);
+  EXPECT_NE(r.undetermined[0].why.find("line"), std::string::npos) << r.undetermined[0].why;
+  const Eigen::Vector3d line(std::cos(0.5), std::sin(0.5), 0);
+  if (!r.covariance.empty()) {  // the sigma is large about the line, small about the rest
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> e(r.covariance[100].topLeftCorner<3, 3>());
+    EXPECT_GT(std::abs(e.eigenvectors().col(2).dot(line)), 0.99);
+    EXPECT_GT(std::sqrt(e.eigenvalues()(2)), 1.0 * M_PI / 180);
+    EXPECT_LT(std::sqrt(e.eigenvalues()(1)), 0.1 * M_PI / 180);
+  }
+  // The rotation error is a rotation about the line (the odometry's frame was turned 57 deg
+  // about a tilted axis: the line fixes everything else).
+  for (size_t k = 0; k < s.truth.size(); k += 40) {
+    const Eigen::Vector3d e =
+        rotation_vector(r.T_enu_lidar.T_world_body[k].R * s.truth.T_world_body[k].R.transpose());
+    EXPECT_LT(e.cross(line).norm(), 0.01) << k << ": " << e.transpose();
+    EXPECT_LT((r.T_enu_lidar.T_world_body[k] * s.p_lidar_antenna -
+               s.truth.T_world_body[k] * s.p_lidar_antenna)
+                  .norm(),
+              0.03)
+        << k;
+  }
+}
+
+// A walk along a line with a 0.7 m lateral sway (less than min_spread_m across it): the sway and
+// the lever arm fix the roll about the line well enough (sigma under 1 deg), and it is solved.
+TEST(PoseGraph, ANearlyStraightPathHasItsRollFromItsSway) {
+  Synthetic s;
+  s.truth = truth_of(40, [](double t) {
+    const double lateral = 0.7 * std::sin(2 * M_PI * t / 8.0);
+    return SE3::from_rotation_vector(
+        Eigen::Vector3d(0, 0, 0.5),
+        Eigen::Vector3d(std::cos(0.5) * t - std::sin(0.5) * lateral,
+                        std::sin(0.5) * t + std::cos(0.5) * lateral, 0));
+  });
+  s.make(1e-4, 1e-3, 0.02, [](double) { return true; });
+  const gt::PoseGraphResult r =
+      gt::solve_pose_graph(s.odometry, s.fixes, s.p_lidar_antenna, gt::PoseGraphConfig{});
+  ASSERT_EQ(r.T_enu_lidar.size(), s.truth.size());
+  EXPECT_TRUE(r.undetermined.empty()) << r.undetermined[0].what << ": " << r.undetermined[0].why;
+  ASSERT_EQ(r.covariance.size(), s.truth.size());
+  size_t within = 0;
+  for (size_t k = 0; k < s.truth.size(); ++k) {
+    const Eigen::Vector3d e =
+        rotation_vector(r.T_enu_lidar.T_world_body[k].R * s.truth.T_world_body[k].R.transpose());
+    within += e.dot(r.covariance[k].topLeftCorner<3, 3>().ldlt().solve(e)) <= 14.16;
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> e(r.covariance[200].topLeftCorner<3, 3>());
+  std::printf(
+      "[ figures ] a 40 m path with a 0.7 m sway: weakest rotation sigma %.3f deg; "
+      "rotations within 3 sigma %.1f %%\n",
+      std::sqrt(e.eigenvalues()(2)) * 180 / M_PI, 100.0 * within / s.truth.size());
+  EXPECT_GE(double(within), 0.95 * double(s.truth.size()));
+}
+
+TEST(PoseGraph, ASequenceStartingInAnOutageIsBridgedByTheOdometryWithGrowingSigmas) {
+  Synthetic s;
+  s.truth = truth_of(60, on_a_loop);
+  s.make(2e-4, 3e-3, 0.02, [](double t) { return t >= 10.0; });
+  const gt::PoseGraphResult r =
+      gt::solve_pose_graph(s.odometry, s.fixes, s.p_lidar_antenna, gt::PoseGraphConfig{});
+  ASSERT_EQ(r.T_enu_lidar.size(), s.truth.size());
+  EXPECT_TRUE(r.undetermined.empty());
+  ASSERT_EQ(r.outages.size(), 1u);
+  EXPECT_EQ(r.outages[0].first, s.truth.stamps.front());
+  EXPECT_NEAR((r.outages[0].second - s.truth.stamps.front()).seconds(), 10.0, 1e-6);
+  ASSERT_EQ(r.covariance.size(), s.truth.size());
+  // The sigmas grow into the outage, backwards from its end; the errors stay inside them.
+  auto sigma = [&](size_t k) {
+    return std::sqrt(r.covariance[k].bottomRightCorner<3, 3>().trace());
+  };
+  EXPECT_GT(sigma(0), sigma(50));
+  EXPECT_GT(sigma(50), sigma(100));
+  EXPECT_GT(sigma(0), 5 * sigma(300));
+  size_t within = 0;
+  std::vector<double> start_errors;
+  for (size_t k = 0; k < s.truth.size(); ++k) {
+    const Eigen::Vector3d e = r.T_enu_lidar.T_world_body[k].t - s.truth.T_world_body[k].t;
+    within += e.dot(r.covariance[k].bottomRightCorner<3, 3>().ldlt().solve(e)) <= 14.16;
+    if (k < 100) start_errors.push_back(e.norm());
+  }
+  std::printf(
+      "[ figures ] a 10 s outage at the start: position sigma at 0 s %.1f mm, 5 s %.1f mm, "
+      "30 s %.1f mm; errors in the outage rms %.1f mm; within 3 sigma %.1f %%\n",
+      1e3 * sigma(0), 1e3 * sigma(50), 1e3 * sigma(300), 1e3 * rms(start_errors),
+      100.0 * double(within) / double(s.truth.size()));
+  EXPECT_GE(double(within), 0.95 * double(s.truth.size()));
+}
+
+TEST(PoseGraph, PositionFixesTakeTheReceiversSigmasItsStatesAndTheClockOffset) {
+  Trajectory T_enu_gnss;
+  for (int i = 0; i < 4; ++i) {
+    T_enu_gnss.stamps.push_back(Time::from_seconds(10.0 + i));
+    T_enu_gnss.T_world_body.push_back(
+        SE3::from_rotation_vector(Eigen::Vector3d::Zero(), Eigen::Vector3d(i, 0, 0)));
+  }
+  const gt::PoseGraphConfig config;
+  // NavSatFix states: 2 (GBAS: RTK fixed), 1 (SBAS), -1 (no fix: left out), 0 (single).
+  const std::vector<gt::PositionFix> f =
+      gt::position_fixes(T_enu_gnss, {}, {2, 1, -1, 0}, 0.25, config);
+  ASSERT_EQ(f.size(), 3u);
+  EXPECT_EQ(f[0].quality, gt::FixQuality::rtk_fixed);
+  EXPECT_EQ(f[1].quality, gt::FixQuality::single);
+  EXPECT_EQ(f[2].quality, gt::FixQuality::single);
+  EXPECT_DOUBLE_EQ(f[2].p_enu.x(), 3.0);
+  EXPECT_EQ(f[0].stamp, Time::from_seconds(10.25));
+  EXPECT_NEAR(std::sqrt(f[0].covariance(0, 0)), config.sigma_rtk_fixed.x(), 1e-12);
+  EXPECT_NEAR(std::sqrt(f[0].covariance(2, 2)), config.sigma_rtk_fixed.y(), 1e-12);
+  EXPECT_NEAR(std::sqrt(f[1].covariance(1, 1)), config.sigma_single.x(), 1e-12);
+  // The receiver's own standard deviations win over its state.
+  const std::vector<Eigen::Vector3d> sd(4, Eigen::Vector3d(0.01, 0.02, 0.05));
+  const std::vector<gt::PositionFix> g = gt::position_fixes(T_enu_gnss, sd, {}, 0.0, config);
+  ASSERT_EQ(g.size(), 4u);
+  EXPECT_NEAR(g[3].covariance(1, 1), 0.02 * 0.02, 1e-15);
+  EXPECT_NEAR(g[3].covariance(2, 2), 0.05 * 0.05, 1e-15);
+  // Zeros (NavSatFix's covariance type unknown): the state's sigmas.
+  std::vector<Eigen::Vector3d> unknown = sd;
+  unknown[1].setZero();
+  const std::vector<gt::PositionFix> u =
+      gt::position_fixes(T_enu_gnss, unknown, {2, 0, 2, 2}, 0.0, config);
+  EXPECT_NEAR(std::sqrt(u[1].covariance(0, 0)), config.sigma_single.x(), 1e-12);
+  EXPECT_NEAR(u[0].covariance(0, 0), 0.01 * 0.01, 1e-15);
+  EXPECT_THROW(gt::position_fixes(T_enu_gnss, {sd[0]}, {}, 0.0, config), Error);
+  EXPECT_THROW(gt::position_fixes(T_enu_gnss, {}, {2, 2}, 0.0, config), Error);
+}
+
+// The fixes CSV read for positions (the ground truth's reading): no attitude columns needed, the
+// receiver's sigmas and NavSatFix's status kept, bad ones refused with their line.
+TEST(GnssFixesCsv, PositionsOnlyNeedNoAttitudeAndKeepSigmasAndStatus) {
+  const std::string text =
+      "time,latitude,longitude,height,status,std_east,std_north,std_up\n"
+      "100.0,41.9,12.5,50.0,2,0.01,0.02,0.03\n"
+      "100.1,41.9000009,12.5,50.0,-1,0,0,0\n";
+  const io::GnssFixes f = io::parse_gnss_fixes(text, "f.csv", std::nullopt);
+  EXPECT_FALSE(f.has_attitude);
+  ASSERT_EQ(f.T_enu_gnss.size(), 2u);
+  EXPECT_NEAR(f.T_enu_gnss.T_world_body[1].t.y(), 0.1, 1e-3);  // 0.0000009 deg of latitude
+  EXPECT_TRUE(f.T_enu_gnss.T_world_body[1].R.isIdentity());
+  ASSERT_EQ(f.status, (std::vector<int>{2, -1}));
+  ASSERT_EQ(f.std_enu_m.size(), 2u);
+  EXPECT_EQ(f.std_enu_m[0], Eigen::Vector3d(0.01, 0.02, 0.03));
+  // With an attitude convention, the attitude columns are required again.
+  EXPECT_THROW(io::parse_gnss_fixes(text, "f.csv", io::Attitude::enu), Error);
+  auto message = [](const std::string& csv) {
+    try {
+      io::parse_gnss_fixes(csv, "f.csv", std::nullopt);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message("time,latitude,longitude,height,status\n1,41.9,12.5,5,3\n").find("f.csv:2"),
+            std::string::npos);
+  EXPECT_NE(
+      message("time,latitude,longitude,height,std_east,std_north,std_up\n1,41.9,12.5,5,-1,1,1\n")
+          .find("standard deviations"),
+      std::string::npos);
+  EXPECT_NE(message("time,latitude,height\n1,41.9,5\n").find("'longitude'"), std::string::npos);
+}
+
+// `rigcal ground-truth` on files: an odometry with its step covariances, GNSS/INS poses, the rig.
+TEST(GroundTruthCli, WritesVbrsFormatAndSigmasRefusesBadInputAndSaysWhatIsUndetermined) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / fmt::format("rigcal_gt_cli_{}", ::getpid());
+  fs::remove_all(dir);
+  fs::create_directories(dir / "rec");
+  Scenario s;
+  s.config.trajectory_duration_s = 30;
+  s.simulate();
+  std::vector<io::StepCovariance> steps;
+  for (size_t k = 0; k + 1 < s.odometry.T_odom_lidar.size(); ++k)
+    steps.push_back({s.odometry.T_odom_lidar.stamps[k], s.odometry.T_odom_lidar.stamps[k + 1],
+                     s.odometry.step_covariance[k]});
+  auto write = [](const fs::path& p, const std::string& text) { std::ofstream(p) << text; };
+  write(dir / "odom.tum", io::trajectory_to_tum(s.odometry.T_odom_lidar));
+  write(dir / "odom_covariances.txt", io::step_covariances_to_text(steps));
+  write(dir / "rec/poses.tum", io::trajectory_to_tum(s.part.gnss));
+  const std::string common = fmt::format("ground-truth {0}/rec --rig {1}/data/sample_rig.yaml",
+                                         dir.string(), RIGCAL_SOURCE_DIR);
+  testing::CliRun r =
+      testing::rigcal_cli(common + fmt::format(" --odometry {0}/odom.tum --gnss {0}/rec/poses.tum "
+                                               "--out {0}/seq_gt.txt --report {0}/report",
+                                               dir.string()),
+                          dir);
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("priors"), std::string::npos) << r.out;
+  const std::string gt_text = testing::slurp(dir / "seq_gt.txt");
+  EXPECT_EQ(gt_text.substr(0, gt_text.find('\n')), "#timestamp tx ty tz qx qy qz qw");
+  EXPECT_TRUE(fs::exists(dir / "seq_gt_sigmas.txt"));
+  const nlohmann::json report =
+      nlohmann::json::parse(testing::slurp(dir / "report/ground_truth.json"));
+  EXPECT_EQ(report["summary"]["poses"].get<size_t>(), s.truth_enu.size());
+  EXPECT_EQ(report["priors"].size(), report["summary"]["priors"].get<size_t>());
+  // Read back, against the truth.
+  const Trajectory gt = io::read_trajectory(dir / "seq_gt.txt").trajectory;
+  ASSERT_EQ(gt.size(), s.truth_enu.size());
+  std::vector<double> errors;
+  for (size_t k = 0; k < gt.size(); ++k) {
+    EXPECT_EQ(gt.stamps[k], s.truth_enu.stamps[k]);
+    errors.push_back((gt.T_world_body[k].t - s.truth_enu.T_world_body[k].t).norm());
+  }
+  EXPECT_LT(rms(errors), 0.03);
+
+  // No covariances beside the odometry: refused, saying what is missing; nothing written.
+  fs::rename(dir / "odom_covariances.txt", dir / "c.txt");
+  r = testing::rigcal_cli(common + fmt::format(" --odometry {0}/odom.tum --gnss {0}/rec/poses.tum "
+                                               "--out {0}/x_gt.txt",
+                                               dir.string()),
+                          dir);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("no step covariances"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "x_gt.txt"));
+  // An output over an input: refused.
+  r = testing::rigcal_cli(common + fmt::format(" --odometry {0}/odom.tum --covariances {0}/c.txt "
+                                               "--gnss {0}/rec/poses.tum --out {0}/rec/poses.tum",
+                                               dir.string()),
+                          dir);
+  EXPECT_EQ(r.status, 2) << r.err;
+  // Fixes an hour off the scans' clock: exit 3, undetermined, no trajectory written.
+  Trajectory late = s.part.gnss;
+  for (Time& t : late.stamps) t = t + Time::from_seconds(3600);
+  write(dir / "late.tum", io::trajectory_to_tum(late));
+  r = testing::rigcal_cli(common + fmt::format(" --odometry {0}/odom.tum --covariances {0}/c.txt "
+                                               "--gnss {0}/late.tum --out {0}/y_gt.txt "
+                                               "--report {0}/late_report",
+                                               dir.string()),
+                          dir);
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_NE(r.err.find("undetermined: every pose"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "y_gt.txt"));
+  EXPECT_TRUE(fs::exists(dir / "late_report/ground_truth.json"));
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rigcal
