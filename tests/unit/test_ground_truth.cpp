@@ -289,12 +289,20 @@ TEST(PoseGraph, ARigStandingStillHasItsPositionButNoHeading) {
   EXPECT_TRUE(r.covariance.empty());  // no sigmas invented for a rotation nothing fixes
   ASSERT_EQ(r.notes.size(), 1u);
   EXPECT_NE(r.notes[0].find("not determined"), std::string::npos);
-  // The antenna is where the fixes put it (301 fixes of 2 cm: their mean to about 1.2 mm).
-  for (size_t k = 0; k < s.truth.size(); k += 50) {
-    const Eigen::Vector3d e = r.T_enu_lidar.T_world_body[k] * s.p_lidar_antenna -
-                              s.truth.T_world_body[k] * s.p_lidar_antenna;
-    EXPECT_LT(e.norm(), 0.01) << k;
+  // The antenna is where the fixes and the odometry put it: a random walk of 1 mm a step seen
+  // through fixes of 2 cm, whose smoothed error is sqrt(sqrt(q r) / 2) = 3.2 mm on each axis
+  // (q, r the step's and the fix's variance), 5.5 mm rms in 3D; 14.5 mm is the 99.99 % point
+  // of that error's length (chi with 3 degrees of freedom).
+  std::vector<double> errors_m;
+  for (size_t k = 0; k < s.truth.size(); ++k) {
+    errors_m.push_back((r.T_enu_lidar.T_world_body[k] * s.p_lidar_antenna -
+                        s.truth.T_world_body[k] * s.p_lidar_antenna)
+                           .norm());
   }
+  std::printf("[ figures ] antenna errors %.1f mm rms, max %.1f mm\n", 1e3 * rms(errors_m),
+              1e3 * *std::max_element(errors_m.begin(), errors_m.end()));
+  EXPECT_LT(rms(errors_m), 0.007);
+  EXPECT_LT(*std::max_element(errors_m.begin(), errors_m.end()), 0.0145);
 }
 
 TEST(PoseGraph, AStraightLineLeavesOnlyTheRollAboutItUndetermined) {
