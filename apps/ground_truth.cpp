@@ -79,10 +79,13 @@ void run(const Options& o) {
   }
   for (const nlohmann::json& n : report["notes"]) fmt::print("note: {}\n", n.get<std::string>());
   if (!o.report.empty()) files[2].content = report.dump(1) + "\n";
-  if (g.T_enu_lidar.empty()) {
-    // Nothing placed: the report only.
+  auto say_undetermined = [&g] {
     for (const gt::Undetermined& u : g.undetermined)
       fmt::print(stderr, "undetermined: {}: {}\n", u.what, u.why);
+  };
+  if (g.T_enu_lidar.empty()) {
+    // Nothing placed: the report only.
+    say_undetermined();
     if (!o.report.empty()) io::write_files_atomic({files[2]});
     throw Exit{3};
   }
@@ -96,8 +99,7 @@ void run(const Options& o) {
              g.covariance.empty() ? "" : ", " + sigmas,
              o.report.empty() ? "" : fmt::format("; report {}/ground_truth.json", o.report));
   if (!g.undetermined.empty()) {
-    for (const gt::Undetermined& u : g.undetermined)
-      fmt::print(stderr, "undetermined: {}: {}\n", u.what, u.why);
+    say_undetermined();
     throw Exit{3};
   }
 }

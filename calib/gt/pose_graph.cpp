@@ -337,9 +337,8 @@ PoseGraphResult solve_pose_graph(const OdometryInput& odometry,
     bool open = true;  // from the first scan
     size_t j = 0;
     for (size_t k = 0; k < n; ++k) {
-      const bool has = j < priors.size() && priors[j].node == k;
-      if (has) ++j;
-      if (has) {
+      if (j < priors.size() && priors[j].node == k) {
+        ++j;
         if (open && scans.stamps[k] - last > Time::from_seconds(config.max_fix_gap_s))
           out.outages.emplace_back(last, scans.stamps[k]);
         open = false;

@@ -8,8 +8,8 @@
 #include <cmath>
 #include <unordered_map>
 
+#include "rigcal/bench/metrics.h"
 #include "rigcal/core/error.h"
-#include "rigcal/core/stats.h"
 #include "rigcal/core/text.h"
 #include "rigcal/core/version.h"
 #include "rigcal/io/trajectory_io.h"
@@ -19,14 +19,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The GNSS sensor's stamps on the base clock: its offset, and its drift where the rig has one.
+// The GNSS sensor's stamps on the base clock.
 Trajectory on_base_clock(Trajectory T_enu_gnss, const rig::Sensor& gnss) {
-  for (Time& t : T_enu_gnss.stamps) {
-    double s = gnss.time_offset;
-    if (gnss.time_drift_ppm)
-      s += *gnss.time_drift_ppm * 1e-6 * (t - gnss.time_drift_epoch).seconds();
-    t = t + Time::from_seconds(s);
-  }
+  for (Time& t : T_enu_gnss.stamps) t = rig::on_base_clock(gnss, t);
   return T_enu_gnss;
 }
 
@@ -158,10 +153,10 @@ nlohmann::json ground_truth_report(const GroundTruthRun& run, const StepInputs& 
     sigma_v.push_back(std::sqrt(c(5, 5)));
     sigma_yaw.push_back(std::sqrt(c(2, 2)) * 180.0 / M_PI);
   }
-  auto stats = [](std::vector<double> v) {
+  auto stats = [](const std::vector<double>& v) {
     if (v.empty()) return nlohmann::json();
-    const double max = *std::max_element(v.begin(), v.end());
-    return nlohmann::json{{"rms", rms(v)}, {"median", median(v)}, {"max", max}};
+    const bench::Stats s = bench::statistics(v);
+    return nlohmann::json{{"rms", s.rmse}, {"median", s.median}, {"max", s.max}};
   };
   nlohmann::json outages = nlohmann::json::array();
   for (const auto& [from, to] : g.outages) {

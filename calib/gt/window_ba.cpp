@@ -10,19 +10,10 @@
 
 #include "rigcal/core/error.h"
 #include "rigcal/gt/point_to_plane_error.h"
-#include "rigcal/lidar/voxel_map.h"
+#include "rigcal/lidar/preprocess.h"
 
 namespace rigcal::gt {
 namespace {
-
-// The first point of each voxel, in input order.
-std::vector<Eigen::Vector3d> downsample(const std::vector<Eigen::Vector3d>& points, double voxel) {
-  std::unordered_map<Eigen::Vector3i, bool, lidar::VoxelHash> seen;
-  std::vector<Eigen::Vector3d> out;
-  for (const Eigen::Vector3d& p : points)
-    if (seen.emplace(lidar::voxel_of(p, voxel), true).second) out.push_back(p);
-  return out;
-}
 
 // One residual: point `index` of scan `scan` on plane `plane`.
 struct Association {
@@ -37,20 +28,19 @@ struct Associations {
 Associations associate(const std::vector<std::vector<Eigen::Vector3d>>& points,
                        const std::vector<SE3>& T_world_lidar, const WindowBaConfig& config) {
   std::vector<Eigen::Vector3d> world;
-  std::vector<std::pair<uint32_t, uint32_t>> label;  // (scan, index) of each world point
-  std::vector<uint32_t> scan_of_point;
+  std::vector<uint32_t> scan_of_point, index_in_scan;
   for (size_t k = 0; k < points.size(); ++k) {
     for (size_t i = 0; i < points[k].size(); ++i) {
       world.push_back(T_world_lidar[k] * points[k][i]);
-      label.emplace_back(uint32_t(k), uint32_t(i));
       scan_of_point.push_back(uint32_t(k));
+      index_in_scan.push_back(uint32_t(i));
     }
   }
   Associations out;
   std::unordered_map<uint32_t, std::vector<uint32_t>> by_scan;
   for (PlanePatch& patch : plane_patches(world, config.patches, &scan_of_point)) {
     by_scan.clear();
-    for (uint32_t m : patch.members) by_scan[label[m].first].push_back(label[m].second);
+    for (uint32_t m : patch.members) by_scan[scan_of_point[m]].push_back(index_in_scan[m]);
     size_t scans = 0;
     for (const auto& [scan, members] : by_scan)
       scans += members.size() >= config.min_points_per_scan;
@@ -92,7 +82,8 @@ WindowBaResult window_ba(const std::vector<std::vector<Eigen::Vector3d>>& points
   out.T_world_lidar = T_world_lidar;
   if (points_lidar.size() < 2) return out;
   std::vector<std::vector<Eigen::Vector3d>> points;
-  for (const auto& scan : points_lidar) points.push_back(downsample(scan, config.voxel_size_m));
+  for (const auto& scan : points_lidar)
+    points.push_back(lidar::voxel_sample(scan, config.voxel_size_m));
 
   std::vector<Eigen::Quaterniond> q(points.size());
   std::vector<Eigen::Vector3d> t(points.size());

@@ -29,6 +29,16 @@ std::vector<ScanPoint> voxel_sample(const std::vector<ScanPoint>& points, double
   return out;
 }
 
+std::vector<Eigen::Vector3d> voxel_sample(const std::vector<Eigen::Vector3d>& points,
+                                          double voxel_size) {
+  std::unordered_set<Eigen::Vector3i, VoxelHash> seen;
+  seen.reserve(points.size() / 4);
+  std::vector<Eigen::Vector3d> out;
+  for (const Eigen::Vector3d& p : points)
+    if (seen.insert(voxel_of(p, voxel_size)).second) out.push_back(p);
+  return out;
+}
+
 std::vector<Eigen::Vector3d> deskew(const std::vector<ScanPoint>& points, const SE3& T_start_next,
                                     double period_s, bool point_times) {
   std::vector<Eigen::Vector3d> out;

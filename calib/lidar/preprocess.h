@@ -20,6 +20,10 @@ SE3 motion_fraction(const SE3& T_start_end, double fraction);
 std::vector<ScanPoint> voxel_sample(const std::vector<ScanPoint>& points, double voxel_size,
                                     double min_range, double max_range);
 
+// The same for points without times or range limits (the bundle adjustment's scans).
+std::vector<Eigen::Vector3d> voxel_sample(const std::vector<Eigen::Vector3d>& points,
+                                          double voxel_size);
+
 // The points moved to the sensor's pose at the scan's stamp (see deskewed_points); as they are
 // where `point_times` is false.
 std::vector<Eigen::Vector3d> deskew(const std::vector<ScanPoint>& points, const SE3& T_start_next,

@@ -55,6 +55,13 @@ Eigen::Matrix3d CameraModel::K() const {
   return k;
 }
 
+Time on_base_clock(const Sensor& sensor, Time t_sensor) {
+  double s = sensor.time_offset;
+  if (sensor.time_drift_ppm)
+    s += *sensor.time_drift_ppm * 1e-6 * (t_sensor - sensor.time_drift_epoch).seconds();
+  return t_sensor + Time::from_seconds(s);
+}
+
 const Sensor* find_sensor(const Rig& rig, std::string_view name) {
   for (const Sensor& s : rig.sensors) {
     if (s.name == name) return &s;

@@ -82,6 +82,9 @@ struct Rig {
 
 // The sensor with that name, or nullptr.
 const Sensor* find_sensor(const Rig& rig, std::string_view name);
+// A stamp of this sensor's clock on the base clock: its time_offset, and its drift where the rig
+// has one (Sensor::time_drift_ppm).
+Time on_base_clock(const Sensor& sensor, Time t_sensor);
 Sensor* find_sensor(Rig& rig, std::string_view name);
 // The sensor with that name; throws rigcal::Error listing the sensors there are.
 const Sensor& sensor(const Rig& rig, std::string_view name);
