@@ -7,41 +7,68 @@
 // planes refitted to the points are its minimum over the planes; the solve its descent over the
 // poses). The first pose is held: the result is the window's shape, its place comes from the
 // pose graph.
+//
+// The sensor moves during a sweep: the poses are knots, one at each scan's stamp and one at the
+// end of the last sweep, and a point measured a fraction f of the way from its scan's stamp to
+// the next knot is placed by the interpolation of the two knots (sweep_point_to_plane_error.h).
+// The sweeps are deskewed by the adjustment itself, with the motion it estimates, and each
+// sweep's motion is its own (not the constant motion of the odometry's deskew).
 #include <Eigen/Core>
 #include <vector>
 
+#include "rigcal/core/scan.h"
 #include "rigcal/core/se3.h"
+#include "rigcal/core/time.h"
 #include "rigcal/gt/plane_patches.h"
+#include "rigcal/gt/types.h"
 
 namespace rigcal::gt {
 
 struct WindowBaConfig {
   double voxel_size_m = 0.2;  // each scan's points downsampled to the first one of each voxel
+  double min_range_m = 0.5, max_range_m = 120.0;  // of the points kept
+  // Points placed by their time between two knots; false: every point at its scan's knot (scans
+  // already deskewed).
+  bool sweep_motion = true;
+  // Knots a sweep (with sweep_motion): 1, the scans' stamps only; 2, one more halfway through
+  // each sweep (the motion bent once a sweep: a walk's bob and sway are not straight over 0.1 s).
+  int knots_per_sweep = 2;
   PatchConfig patches;
   // Of each patch, the points of a scan that contributes at least `min_points_per_scan`, at most
   // `max_points_per_scan` of them (evenly spread over its list); patches seen by one scan only
   // are left out (they fix nothing).
-  size_t min_points_per_scan = 3, max_points_per_scan = 10;
+  size_t min_points_per_scan = 3, max_points_per_scan = 5;
   double point_sigma_m = 0.01;  // the points' noise along a normal (the range noise)
   double huber_sigmas = 3.0;    // Huber scale of the point-to-plane residual, in point sigmas
-  int rounds = 6;               // map rebuilt and solved again, at most
+  int rounds = 4;               // map rebuilt and solved again, at most
   int max_iterations = 15;      // of each round's solve
   // Rounds stop when no pose moved more than this (m, and the same in rad over 10 m).
   double converged_m = 1e-4;
+  // The covariance of each motion between consecutive knots (WindowBaResult::step_covariance).
+  bool step_covariances = false;
+  int threads = 0;  // of the solver; 0: one a core
 };
 
 struct WindowBaResult {
-  std::vector<SE3> T_world_lidar;  // the first one as given
+  std::vector<SE3> T_world_lidar;  // the knots, the first one as given
   int rounds = 0;
   size_t patches = 0, residuals = 0;  // of the last round
   // The points' distances to their planes (m), over the residuals of the first and the last
   // round: the map's crispness before and after.
   double rms_before_m = 0, rms_after_m = 0;
+  // With step_covariances: the motion from knot k to knot k + 1 (one fewer than the knots), in
+  // the odometry's convention (types.h: rotation first, the motion perturbed on the left, in knot
+  // k's frame), from the last round's information with the planes marginalized, scaled up by the
+  // residuals' variance over point_sigma_m^2 when that is larger than 1. Empty when the
+  // information is singular (a knot no point depends on, a scene without planes enough).
+  std::vector<Matrix6d> step_covariance;
 };
 
-// `points_lidar[k]`: scan k's points in its own frame at its stamp (deskewed); `T_world_lidar`:
-// the initial poses, one a scan.
-WindowBaResult window_ba(const std::vector<std::vector<Eigen::Vector3d>>& points_lidar,
-                         const std::vector<SE3>& T_world_lidar, const WindowBaConfig& config);
+// `scans`: in time order, each point in the sensor frame at its own time (Scan::point_times false,
+// or sweep_motion false: at the scan's stamp); `T_world_lidar`: the initial knots, one a scan and
+// the last at `end` (the end of the last sweep: the next scan's stamp). A knot no point depends on
+// (the last, when the scans have no times) comes back as given.
+WindowBaResult window_ba(const std::vector<Scan>& scans, const std::vector<SE3>& T_world_lidar,
+                         Time end, const WindowBaConfig& config);
 
 }  // namespace rigcal::gt

@@ -81,30 +81,73 @@ void keep(OdometryRun& run, Step step, const std::string& source) {
   }
 }
 
-// An Ouster capture streamed: frames assembled packet by packet, never written anywhere.
-void register_capture(const fs::path& pcap, Odometry& odometry, OdometryRun& run,
-                      const report::Progress& progress) {
-  const fs::path json = fs::path(pcap).replace_extension(".json");
-  if (!fs::exists(json)) {
-    throw Error(
-        fmt::format("{}: the capture's metadata {} is not beside it (or convert first: "
-                    "rigcal convert {} --metadata M.json --out RECORDING)",
-                    pcap.string(), json.filename().string(), pcap.string()));
+}  // namespace
+
+struct ScanStream::Impl {
+  fs::path scans;
+  std::unique_ptr<io::OusterPcapReader> capture;  // or the folder:
+  io::StampedFolder folder;
+  size_t without_times = 0;
+};
+
+ScanStream::ScanStream(const fs::path& scans) : impl_(std::make_unique<Impl>()) {
+  impl_->scans = scans;
+  if (fs::is_regular_file(scans) && io::is_pcap_capture(scans)) {
+    const fs::path json = fs::path(scans).replace_extension(".json");
+    if (!fs::exists(json)) {
+      throw Error(
+          fmt::format("{}: the capture's metadata {} is not beside it (or convert first: "
+                      "rigcal convert {} --metadata M.json --out RECORDING)",
+                      scans.string(), json.filename().string(), scans.string()));
+    }
+    impl_->capture = std::make_unique<io::OusterPcapReader>(scans, io::read_ouster_metadata(json));
+  } else {
+    impl_->folder = stamped_scans(scans);
   }
-  io::OusterPcapReader reader(pcap, io::read_ouster_metadata(json));
-  while (const std::optional<Scan> scan = reader.next_scan()) {
-    keep(run, register_scan(odometry, *scan), pcap.string());
-    report::tell(progress, "odometry: scans read", run.steps.size(), 0);
-  }
-  const io::OusterCaptureCounters& c = reader.counters();
-  run.notes.push_back(
-      fmt::format("capture read as it streams: {} frames complete, {} incomplete; "
-                  "{} packets skipped{}{}",
-                  c.frames_complete, c.frames_incomplete, c.skipped_total(),
-                  c.note.empty() ? "" : "; ", c.note));
 }
 
-}  // namespace
+ScanStream::~ScanStream() = default;
+
+std::optional<Scan> ScanStream::next() {
+  if (impl_->capture) {
+    std::optional<Scan> scan = impl_->capture->next_scan();
+    read_ += scan.has_value();
+    return scan;
+  }
+  if (read_ >= impl_->folder.files.size()) return std::nullopt;
+  const std::string& file = impl_->folder.files[read_];
+  Scan scan = io::read_scan(file);
+  if (scan.points.empty()) throw Error(fmt::format("{}: no points", file));
+  scan.stamp = impl_->folder.stamps[read_];
+  impl_->without_times += !scan.point_times;
+  ++read_;
+  return scan;
+}
+
+size_t ScanStream::total() const { return impl_->capture ? 0 : impl_->folder.files.size(); }
+
+std::string ScanStream::source() const {
+  if (impl_->capture || read_ == 0) return impl_->scans.string();
+  return impl_->folder.files[read_ - 1];
+}
+
+std::vector<std::string> ScanStream::notes() const {
+  std::vector<std::string> out;
+  if (impl_->capture) {
+    const io::OusterCaptureCounters& c = impl_->capture->counters();
+    out.push_back(
+        fmt::format("capture read as it streams: {} frames complete, {} incomplete; "
+                    "{} packets skipped{}{}",
+                    c.frames_complete, c.frames_incomplete, c.skipped_total(),
+                    c.note.empty() ? "" : "; ", c.note));
+  } else if (impl_->without_times > 0) {
+    out.push_back(fmt::format(
+        "{} of {} scans have no per-point times (KITTI points, PCD): they are used as measured, "
+        "not deskewed",
+        impl_->without_times, read_));
+  }
+  return out;
+}
 
 OdometryRun run_odometry(const fs::path& scans, const OdometryConfig& config,
                          const report::Progress& progress) {
@@ -113,26 +156,12 @@ OdometryRun run_odometry(const fs::path& scans, const OdometryConfig& config,
   run.scans = scans;
   run.config = config;
   Odometry odometry = start_odometry(config);
-  if (fs::is_regular_file(scans) && io::is_pcap_capture(scans)) {
-    register_capture(scans, odometry, run, progress);
-  } else {
-    const io::StampedFolder folder = stamped_scans(scans);
-    size_t without_times = 0;
-    for (size_t k = 0; k < folder.files.size(); ++k) {
-      Scan scan = io::read_scan(folder.files[k]);
-      if (scan.points.empty()) throw Error(fmt::format("{}: no points", folder.files[k]));
-      scan.stamp = folder.stamps[k];
-      without_times += !scan.point_times;
-      keep(run, register_scan(odometry, scan), folder.files[k]);
-      report::tell(progress, "odometry: scans read", k + 1, folder.files.size());
-    }
-    if (without_times > 0) {
-      run.notes.push_back(fmt::format(
-          "{} of {} scans have no per-point times (KITTI points, PCD): they are registered as "
-          "measured, not deskewed",
-          without_times, folder.files.size()));
-    }
+  ScanStream stream(scans);
+  while (std::optional<Scan> scan = stream.next()) {
+    keep(run, register_scan(odometry, *scan), stream.source());
+    report::tell(progress, "odometry: scans read", stream.read(), stream.total());
   }
+  for (const std::string& n : stream.notes()) run.notes.push_back(n);
   size_t skipped = 0;
   for (const Step& s : run.steps) skipped += !s.skipped.empty();
   if (skipped > 0) {

@@ -2,10 +2,13 @@
 // The odometry step (doc/odometry.md): the scans of a recording, streamed one at a time through
 // the odometry, with the trajectory, the per-step covariances and a report as the result.
 #include <filesystem>
+#include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "rigcal/core/scan.h"
 #include "rigcal/io/odometry_io.h"
 #include "rigcal/lidar/odometry.h"
 #include "rigcal/report/step.h"
@@ -21,6 +24,31 @@ namespace rigcal::lidar {
 // Throws rigcal::Error saying what was looked for.
 std::filesystem::path scans_folder(const std::filesystem::path& given,
                                    const report::Progress& progress = {});
+
+// The scans of `scans` (a folder or a capture, as scans_folder gives), one at a time in stamp
+// order: a folder's stamps from its timestamps.txt (each sweep's first point, the time its
+// per-point times count from), a capture's from the sensor (its first valid column's), the capture
+// assembled packet by packet as it streams. Throws rigcal::Error naming the file on a scan not
+// read.
+class ScanStream {
+ public:
+  explicit ScanStream(const std::filesystem::path& scans);
+  ~ScanStream();
+  ScanStream(const ScanStream&) = delete;
+  ScanStream& operator=(const ScanStream&) = delete;
+  std::optional<Scan> next();
+  size_t read() const { return read_; }
+  size_t total() const;        // of a folder; 0 for a capture (not known before the end)
+  std::string source() const;  // the file of the last scan read, or the capture
+  // What the stream saw that its reader should say: the scans without point times, a capture's
+  // counters (once the stream is done).
+  std::vector<std::string> notes() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  size_t read_ = 0;
+};
 
 // A run stops (rigcal::Error) when this many scans in a row share no surface with the map: the
 // odometry is lost, and a trajectory that jumps would be worse than none.

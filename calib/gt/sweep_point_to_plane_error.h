@@ -1,0 +1,42 @@
+#pragma once
+// The bundle adjustment's geometric term for a point measured during the sweep
+// (doc/ground-truth.md): the sensor's motion between two knots (the scan's stamp and the next
+// one) taken as the interpolation of the two poses (rotation exp(f log(R_a' R_b)), translation
+// t_a + f (t_b - t_a), what lidar::motion_fraction does), the point placed by the pose at its
+// fraction f of the way and measured against its plane as PointToPlaneError.
+#include <ceres/rotation.h>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace rigcal::gt {
+
+struct SweepPointToPlaneError {
+  Eigen::Vector3d p_lidar;  // the point in the sensor frame at its own time
+  double fraction = 0;      // its time from knot a, over the time from knot a to knot b
+  Eigen::Vector3d c_world;  // the plane's anchor
+  double inv_sigma = 1.0;   // 1 / the point's noise along the normal, 1/m
+
+  template <class T>
+  bool operator()(const T* q_world_a, const T* t_world_a, const T* q_world_b, const T* t_world_b,
+                  const T* plane, T* residual) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> qa(q_world_a), qb(q_world_b);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> ta(t_world_a), tb(t_world_b), n(plane);
+    const Eigen::Quaternion<T> q_a_b = qa.conjugate() * qb;
+    // ceres' order is w x y z; the shorter way round (q and -q are one rotation).
+    const T sign = q_a_b.w() < T(0) ? T(-1) : T(1);
+    const T wxyz[4] = {sign * q_a_b.w(), sign * q_a_b.x(), sign * q_a_b.y(), sign * q_a_b.z()};
+    T phi[3];
+    ceres::QuaternionToAngleAxis(wxyz, phi);
+    for (T& c : phi) c *= T(fraction);
+    const T p[3] = {T(p_lidar.x()), T(p_lidar.y()), T(p_lidar.z())};
+    T p_turned[3];
+    ceres::AngleAxisRotatePoint(phi, p, p_turned);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> p_a(p_turned);
+    const Eigen::Matrix<T, 3, 1> p_world = qa * p_a + ta + T(fraction) * (tb - ta);
+    residual[0] = T(inv_sigma) * (n.dot(p_world - c_world.cast<T>()) - plane[3]);
+    return true;
+  }
+};
+
+}  // namespace rigcal::gt
