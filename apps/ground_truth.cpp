@@ -19,9 +19,12 @@ namespace {
 namespace fs = std::filesystem;
 
 struct Options {
-  std::string recording, rig, out, sigmas, odometry, covariances, gnss, report;
+  std::string recording, rig, out, sigmas, odometry, covariances, gnss, report, scans;
   std::string gnss_sensor = "gnss", odometry_preset;
   double max_fix_gap_s = 0.5, fix_correlation_s = 0.0;
+  bool no_bundle_adjustment = false;
+  size_t window_scans = gt::SequenceBaConfig{}.window_scans;
+  size_t window_overlap = gt::SequenceBaConfig{}.overlap_scans;
 };
 
 fs::path default_gnss(const fs::path& recording) {
@@ -36,16 +39,25 @@ void run(const Options& o) {
   in.rig = rig::read_rig_file(o.rig);
   in.rig_source = o.rig;
   in.gnss = o.gnss.empty() ? default_gnss(o.recording) : fs::path(o.gnss);
-  if (!o.odometry.empty()) {
-    in.odometry = o.odometry, in.covariances = o.covariances;
-  } else {
+  if (!o.scans.empty()) {
+    in.scans = lidar::scans_folder(o.scans, console_progress());
+  } else if (o.odometry.empty()) {
     in.scans = lidar::scans_folder(o.recording, console_progress());
+  } else if (!o.no_bundle_adjustment) {
+    try {  // the scans of the bundle adjustment, when the recording has them
+      in.scans = lidar::scans_folder(o.recording, console_progress());
+    } catch (const Error&) {
+    }
   }
+  if (!o.odometry.empty()) in.odometry = o.odometry, in.covariances = o.covariances;
   gt::StepOptions options;
   options.gnss_sensor = o.gnss_sensor;
   options.odometry_preset = o.odometry_preset;
   options.pose_graph.max_fix_gap_s = o.max_fix_gap_s;
   options.pose_graph.fix_correlation_s = o.fix_correlation_s;
+  options.bundle_adjustment = !o.no_bundle_adjustment;
+  options.ba.window_scans = o.window_scans;
+  options.ba.overlap_scans = o.window_overlap;
   const std::string sigmas =
       o.sigmas.empty() ? fs::path(o.out).replace_extension("").string() + "_sigmas.txt" : o.sigmas;
   std::vector<io::OutputFile> files = {{o.out, ""}, {sigmas, ""}};
@@ -76,6 +88,17 @@ void run(const Options& o) {
                1e3 * s["pose_sigma_horizontal_m"]["median"].get<double>(),
                1e3 * s["pose_sigma_horizontal_m"]["max"].get<double>(),
                s["pose_sigma_yaw_deg"]["median"].get<double>());
+  }
+  if (run.ba) {
+    const nlohmann::json& b = report["bundle_adjustment"];
+    fmt::print(
+        "bundle adjustment: {} windows in {:.1f} s; points off their planes rms {:.1f} mm before, "
+        "{:.1f} mm after (median over the windows); poses moved {:.1f} mm rms from the pose "
+        "graph's\n",
+        run.ba->windows.size(), run.ba->seconds,
+        1e3 * b["point_plane_rms_before_m"]["median"].get<double>(),
+        1e3 * b["point_plane_rms_after_m"]["median"].get<double>(),
+        1e3 * b["pose_change_from_stage1_m"]["rms"].get<double>());
   }
   for (const nlohmann::json& n : report["notes"]) fmt::print("note: {}\n", n.get<std::string>());
   if (!o.report.empty()) files[2].content = report.dump(1) + "\n";
@@ -114,11 +137,15 @@ void add_ground_truth(CLI::App& app) {
       "poses with the odometry's steps weighted by their covariances and the GNSS fixes as\n"
       "position priors through the lever arm (robust solve, a chi-square gate, a second\n"
       "solve). Writes OUT (VBR's <seq>_gt.txt: T_enu_lidar, ENU at the first fix) and each\n"
-      "pose's sigmas. Exit 3 when the fixes leave something undetermined (said on stderr).\n"
-      "Stage 1 of the method: the LiDAR bundle adjustment is not built yet.");
+      "pose's sigmas. Then, when the scans are there, the geometric LiDAR bundle adjustment:\n"
+      "overlapping windows of scans, each sweep deskewed by the motion it estimates, the\n"
+      "points brought onto planar patches; the windows' motions replace the odometry's in the\n"
+      "pose graph, solved again with the same priors. Exit 3 when the fixes leave something\n"
+      "undetermined (said on stderr). The photometric term is not built.");
   cmd->add_option("recording", o->recording,
-                  "the recording: its gnss/ (poses.tum, fixes.csv or navsat.csv) and, without "
-                  "--odometry, its scans (ouster_points/, a capture, a session)")
+                  "the recording: its gnss/ (poses.tum, fixes.csv or navsat.csv) and its scans "
+                  "(ouster_points/, a capture, a session): the odometry's without --odometry, "
+                  "the bundle adjustment's")
       ->required();
   cmd->add_option("--rig", o->rig, "the calibration: the GNSS sensor's T_b and time_offset")
       ->required();
@@ -145,7 +172,19 @@ void add_ground_truth(CLI::App& app) {
                   "(0: independent)")
       ->check(seconds_within(0, 600))
       ->capture_default_str();
-  cmd->add_option("--report", o->report, "report folder: ground_truth.json, one row a prior");
+  cmd->add_option("--scans", o->scans,
+                  "the scans (a folder, a capture, a recording; default: the recording's)");
+  cmd->add_flag("--no-bundle-adjustment", o->no_bundle_adjustment,
+                "stop at the pose graph (stage 1)");
+  cmd->add_option("--window-scans", o->window_scans, "scans a bundle-adjustment window")
+      ->check(CLI::Range(size_t(2), size_t(1000)))
+      ->capture_default_str();
+  cmd->add_option("--window-overlap", o->window_overlap,
+                  "scans each window shares with the previous one")
+      ->check(CLI::Range(size_t(0), size_t(999)))
+      ->capture_default_str();
+  cmd->add_option("--report", o->report,
+                  "report folder: ground_truth.json, one row a prior, one a window");
   cmd->callback([o] { run(*o); });
 }
 

@@ -134,4 +134,22 @@ SE3 se3_from_text(std::string_view text) {
   return SE3::from_quaternion(q, Eigen::Vector3d(v[0], v[1], v[2]));
 }
 
+Eigen::Matrix3d so3_right_jacobian(const Eigen::Vector3d& phi) {
+  const double theta = phi.norm();
+  const Eigen::Matrix3d W = skew(phi);
+  if (theta < 1e-5) return Eigen::Matrix3d::Identity() - 0.5 * W + W * W / 6.0;
+  const double t2 = theta * theta;
+  return Eigen::Matrix3d::Identity() - (1 - std::cos(theta)) / t2 * W +
+         (theta - std::sin(theta)) / (t2 * theta) * W * W;
+}
+
+Eigen::Matrix3d so3_right_jacobian_inverse(const Eigen::Vector3d& phi) {
+  const double theta = phi.norm();
+  const Eigen::Matrix3d W = skew(phi);
+  if (theta < 1e-5) return Eigen::Matrix3d::Identity() + 0.5 * W + W * W / 12.0;
+  const double t2 = theta * theta;
+  return Eigen::Matrix3d::Identity() + 0.5 * W +
+         (1 / t2 - (1 + std::cos(theta)) / (2 * theta * std::sin(theta))) * W * W;
+}
+
 }  // namespace rigcal

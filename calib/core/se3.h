@@ -47,6 +47,10 @@ double orthonormality_error(const Eigen::Matrix3d& R);
 // The rotation closest to M in the Frobenius norm (SVD projection).
 Eigen::Matrix3d nearest_rotation(const Eigen::Matrix3d& M);
 Eigen::Matrix3d skew(const Eigen::Vector3d& v);
+// SO(3)'s right Jacobian J_r(phi): Exp(phi + d) = Exp(phi) Exp(J_r(phi) d) to first order; and
+// its inverse: Log(Exp(phi) Exp(d)) = phi + J_r(phi)^-1 d.
+Eigen::Matrix3d so3_right_jacobian(const Eigen::Vector3d& phi);
+Eigen::Matrix3d so3_right_jacobian_inverse(const Eigen::Vector3d& phi);
 // T moved by d = (rotation vector, translation): R' = exp(d_rot) R, t' = t + d_t. The tangent
 // every 6 x 6 covariance of a pose in rigcal is expressed in (rotation first, left perturbation).
 SE3 perturbed(const SE3& T, const Eigen::Matrix<double, 6, 1>& d);

@@ -4,6 +4,11 @@
 // pose graph keeps them: an Eigen quaternion (x y z w) and a translation, T_world_lidar; the
 // plane estimated with them: its unit normal n and its offset d from an anchor point c (the
 // patch's centroid when it was found), the plane {x : n . (x - c) = d}.
+//
+// PointToPlaneError defines the residual; PointToPlaneCost evaluates it with its Jacobians
+// written out (as SweepPointToPlaneCost, checked against the automatic ones in the tests).
+#include <ceres/sized_cost_function.h>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -24,6 +29,17 @@ struct PointToPlaneError {
     residual[0] = T(inv_sigma) * (n.dot(p_world - c_world.cast<T>()) - plane[3]);
     return true;
   }
+};
+
+// Parameter blocks: q_world_lidar (EigenQuaternionManifold), t_world_lidar, plane (n then d).
+class PointToPlaneCost final : public ceres::SizedCostFunction<1, 4, 3, 4> {
+ public:
+  explicit PointToPlaneCost(const PointToPlaneError& e) : e_(e) {}
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  PointToPlaneError e_;
 };
 
 }  // namespace rigcal::gt

@@ -53,6 +53,7 @@ SequenceBaResult sequence_ba(const std::function<std::optional<Scan>()>& next_sc
       odometry.step_covariance.size() + 1 != n)
     throw Error("bundle adjustment: the initial poses and the odometry differ in their stamps");
   SequenceBaResult out;
+  out.config = config;
   if (n < 2) return out;
   const Windows plan = plan_windows(n, config);
   std::map<int64_t, size_t> pose_of_stamp;

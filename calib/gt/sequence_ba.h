@@ -37,6 +37,7 @@ struct WindowSummary {
 };
 
 struct SequenceBaResult {
+  SequenceBaConfig config;
   // The poses chained from the windows' motions (from the initial first pose) and those motions'
   // covariances: the pose graph's input, in place of the odometry's.
   OdometryInput motions;

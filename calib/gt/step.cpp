@@ -122,6 +122,35 @@ GroundTruthRun run_ground_truth(const StepInputs& in, const StepOptions& o,
   report::tell(progress, "solving the pose graph", 0, 1);
   run.graph = solve_pose_graph(odometry, run.fixes, run.p_lidar_antenna, o.pose_graph);
   report::tell(progress, "solving the pose graph", 1, 1);
+
+  // Stage 2: the windows start from the graph's poses; their motions, in a graph again.
+  if (!o.bundle_adjustment) {
+    run.notes.push_back("bundle adjustment not asked for: the trajectory is the pose graph's");
+  } else if (in.scans.empty()) {
+    run.notes.push_back(
+        "no scans given or found: no bundle adjustment, the trajectory is the pose graph's");
+  } else if (run.graph.T_enu_lidar.size() != odometry.T_odom_lidar.size()) {
+    run.notes.push_back("the pose graph placed no poses: no bundle adjustment");
+  } else {
+    lidar::ScanStream stream(in.scans);
+    run.ba =
+        sequence_ba([&] { return stream.next(); }, run.graph.T_enu_lidar, odometry, o.ba, progress);
+    if (run.ba->motions_from_odometry > 0) {
+      run.notes.push_back(fmt::format(
+          "bundle adjustment: {} of {} motions kept from the odometry (their windows' information "
+          "was singular: the report's windows say which)",
+          run.ba->motions_from_odometry, run.ba->motions.step_covariance.size()));
+    }
+    if (run.ba->scans_unused > 0) {
+      run.notes.push_back(
+          fmt::format("bundle adjustment: {} scans stamped at no pose of the odometry, not used",
+                      run.ba->scans_unused));
+    }
+    report::tell(progress, "solving the pose graph of the adjusted motions", 0, 1);
+    run.stage1 = std::move(run.graph);
+    run.graph = solve_pose_graph(run.ba->motions, run.fixes, run.p_lidar_antenna, o.pose_graph);
+    report::tell(progress, "solving the pose graph of the adjusted motions", 1, 1);
+  }
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return run;
 }
@@ -187,6 +216,47 @@ nlohmann::json ground_truth_report(const GroundTruthRun& run, const StepInputs& 
                   {"pose_sigma_yaw_deg", stats(sigma_yaw)},
                   {"solver_iterations", g.iterations},
                   {"seconds", run.seconds}};
+  if (run.ba) {
+    const SequenceBaResult& ba = *run.ba;
+    std::vector<double> before, after;
+    nlohmann::json windows = nlohmann::json::array();
+    for (const WindowSummary& w : ba.windows) {
+      before.push_back(w.rms_before_m);
+      after.push_back(w.rms_after_m);
+      windows.push_back({{"first_pose", w.first_pose},
+                         {"scans", w.scans},
+                         {"rounds", w.rounds},
+                         {"patches", w.patches},
+                         {"residuals", w.residuals},
+                         {"point_plane_rms_before_m", w.rms_before_m},
+                         {"point_plane_rms_after_m", w.rms_after_m},
+                         {"covariances", w.covariances},
+                         {"seconds", w.seconds}});
+    }
+    // How far the adjustment moved the poses from stage 1's.
+    std::vector<double> moved_m, turned_deg;
+    for (size_t k = 0; run.stage1 && k < g.T_enu_lidar.size(); ++k) {
+      const SE3 d =
+          run.stage1->T_enu_lidar.T_world_body[k].inverse() * g.T_enu_lidar.T_world_body[k];
+      moved_m.push_back(d.t.norm());
+      turned_deg.push_back(rotation_angle(d.R) * 180.0 / M_PI);
+    }
+    j["bundle_adjustment"] = {{"windows", ba.windows.size()},
+                              {"config",
+                               {{"window_scans", ba.config.window_scans},
+                                {"overlap_scans", ba.config.overlap_scans},
+                                {"knots_per_sweep", ba.config.window.knots_per_sweep},
+                                {"voxel_size_m", ba.config.window.voxel_size_m},
+                                {"point_sigma_m", ba.config.window.point_sigma_m}}},
+                              {"point_plane_rms_before_m", stats(before)},
+                              {"point_plane_rms_after_m", stats(after)},
+                              {"motions_from_odometry", ba.motions_from_odometry},
+                              {"scans_unused", ba.scans_unused},
+                              {"pose_change_from_stage1_m", stats(moved_m)},
+                              {"rotation_change_from_stage1_deg", stats(turned_deg)},
+                              {"seconds", ba.seconds},
+                              {"per_window", std::move(windows)}};
+  }
   j["notes"] = run.notes;
   for (const std::string& n : g.notes) j["notes"].push_back(n);
   nlohmann::json priors = nlohmann::json::array();

@@ -2,7 +2,9 @@
 // The ground-truth step (doc/ground-truth.md): the LiDAR odometry (a file with its step
 // covariances, or rigcal's own run on the scans) and the GNSS fixes of a recording, through the
 // pose graph, into the LiDAR's trajectory in the fixes' local ENU frame with each pose's
-// covariance. Stage 1 of the paper's method; the LiDAR bundle adjustment (stage 2) is not built.
+// covariance (stage 1 of the paper's method); then, when the scans are there, the geometric
+// LiDAR bundle adjustment over overlapping windows, whose motions replace the odometry's in a
+// second pose graph with the same priors (stage 2, without its photometric term).
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -10,6 +12,7 @@
 #include <vector>
 
 #include "rigcal/gt/pose_graph.h"
+#include "rigcal/gt/sequence_ba.h"
 #include "rigcal/io/gnss_fixes.h"
 #include "rigcal/lidar/step.h"
 #include "rigcal/report/step.h"
@@ -23,6 +26,9 @@ struct StepOptions {
   // rigcal's odometry, when it runs on StepInputs::scans (lidar::choose_preset).
   std::string odometry_preset;
   bool odometry_sweep_motion = false;
+  // Stage 2 on StepInputs::scans (skipped, with a note, when there are none).
+  bool bundle_adjustment = true;
+  SequenceBaConfig ba;
 };
 
 struct StepInputs {
@@ -30,7 +36,8 @@ struct StepInputs {
   // format; `covariances` empty: beside the odometry, its name without extension +
   // _covariances.txt, what `rigcal odometry` writes).
   std::filesystem::path odometry, covariances;
-  // Or, with `odometry` empty, the scans (as lidar::scans_folder gives): rigcal's odometry runs.
+  // The scans (as lidar::scans_folder gives): rigcal's odometry runs on them when `odometry` is
+  // empty, and the bundle adjustment on them (their stamps the odometry's).
   std::filesystem::path scans;
   // GNSS/INS poses (T_enu_gnss; their positions are used) or a CSV of fixes (positions only).
   std::filesystem::path gnss;
@@ -39,7 +46,10 @@ struct StepInputs {
 };
 
 struct GroundTruthRun {
-  PoseGraphResult graph;
+  PoseGraphResult graph;  // the last stage's
+  // With the bundle adjustment: its windows, and the pose graph of stage 1 it started from.
+  std::optional<SequenceBaResult> ba;
+  std::optional<PoseGraphResult> stage1;
   std::vector<PositionFix> fixes;
   Eigen::Vector3d p_lidar_antenna = Eigen::Vector3d::Zero();
   std::optional<io::GeodeticOrigin> origin;    // of the ENU frame, when the GNSS gave fixes
@@ -61,7 +71,8 @@ GroundTruthRun run_ground_truth(const StepInputs& inputs, const StepOptions& opt
                                 const report::Progress& progress = {});
 
 // The report: the inputs, a summary (poses, path, fixes, priors used and rejected, outages, what
-// is undetermined, the priors' residuals, the poses' sigmas) and one row a prior
+// is undetermined, the priors' residuals, the poses' sigmas), the bundle adjustment's windows
+// (their residuals before and after: the map's crispness) and one row a prior
 // (doc/ground-truth.md says what each number is).
 nlohmann::json ground_truth_report(const GroundTruthRun& run, const StepInputs& inputs);
 

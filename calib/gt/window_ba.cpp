@@ -243,15 +243,12 @@ WindowBaResult window_ba(const std::vector<Scan>& scans, const std::vector<SE3>&
       auto* loss = new ceres::HuberLoss(config.huber_sigmas);
       const size_t k = p.knot;
       if (p.fraction == 0) {
-        problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PointToPlaneError, 1, 4, 3, 4>(
-                                     new PointToPlaneError{p.p_lidar, c, w}),
-                                 loss, q[k].coeffs().data(), t[k].data(), plane[r.plane].data());
+        problem.AddResidualBlock(new PointToPlaneCost({p.p_lidar, c, w}), loss,
+                                 q[k].coeffs().data(), t[k].data(), plane[r.plane].data());
       } else {
-        problem.AddResidualBlock(
-            new ceres::AutoDiffCostFunction<SweepPointToPlaneError, 1, 4, 3, 4, 3, 4>(
-                new SweepPointToPlaneError{p.p_lidar, p.fraction, c, w}),
-            loss, q[k].coeffs().data(), t[k].data(), q[k + 1].coeffs().data(), t[k + 1].data(),
-            plane[r.plane].data());
+        problem.AddResidualBlock(new SweepPointToPlaneCost({p.p_lidar, p.fraction, c, w}), loss,
+                                 q[k].coeffs().data(), t[k].data(), q[k + 1].coeffs().data(),
+                                 t[k + 1].data(), plane[r.plane].data());
       }
     }
     for (size_t j = 0; j < a.planes.size(); ++j) {

@@ -1,6 +1,8 @@
 // The LiDAR bundle adjustment's geometric stage (calib/gt/plane_patches, window_ba): planar
 // patches of a known scene, and one window of a simulated walk's sweeps brought back onto their
 // planes from perturbed poses, scored against the simulator's truth.
+#include <ceres/autodiff_cost_function.h>
+#include <ceres/manifold.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -11,7 +13,9 @@
 
 #include "rigcal/core/stats.h"
 #include "rigcal/gt/plane_patches.h"
+#include "rigcal/gt/point_to_plane_error.h"
 #include "rigcal/gt/sequence_ba.h"
+#include "rigcal/gt/sweep_point_to_plane_error.h"
 #include "rigcal/gt/window_ba.h"
 #include "rigcal/rig/rig_yaml.h"
 #include "rigcal/sim/session.h"
@@ -136,6 +140,66 @@ void knot_errors(const std::vector<SE3>& truth, const std::vector<SE3>& T_world_
   }
 }
 double max_of(const std::vector<double>& v) { return *std::max_element(v.begin(), v.end()); }
+
+// The written-out Jacobians of the point-to-plane terms against Ceres' automatic ones, in the
+// manifolds' tangent spaces (the ambient ones may differ along the quaternion itself), at random
+// knots up to 0.6 rad apart and fractions over the whole segment.
+TEST(PointToPlaneCost, JacobiansMatchAutomaticDifferentiation) {
+  std::mt19937_64 rng(21);
+  std::normal_distribution<double> N(0.0, 1.0);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  auto vec = [&](double s) { return Eigen::Vector3d(s * N(rng), s * N(rng), s * N(rng)); };
+  auto tangent = [](const double* q, const double* J_ambient) {
+    Eigen::Matrix<double, 4, 3, Eigen::RowMajor> plus;
+    ceres::EigenQuaternionManifold().PlusJacobian(q, plus.data());
+    return Eigen::Matrix<double, 1, 3>(Eigen::Map<const Eigen::Matrix<double, 1, 4>>(J_ambient) *
+                                       plus);
+  };
+  double worst = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    Eigen::Quaterniond qa(rotation_from_vector(vec(1.0)));
+    Eigen::Quaterniond qb(rotation_from_vector(vec(0.2)) * qa.toRotationMatrix());
+    if (trial % 3 == 0) qb.coeffs() *= -1;  // the same rotation, the other sign
+    Eigen::Vector3d ta = vec(5.0), tb = ta + vec(0.2);
+    Eigen::Vector4d plane;
+    plane << vec(1.0).normalized(), 0.1 * N(rng);
+    const gt::SweepPointToPlaneError e{vec(10.0), trial % 5 == 0 ? 1e-9 : U(rng), vec(10.0), 100.0};
+    const double* params[5] = {qa.coeffs().data(), ta.data(), qb.coeffs().data(), tb.data(),
+                               plane.data()};
+    double r_auto = 0, r_ours = 0;
+    double J_auto[5][4], J_ours[5][4];
+    double* Ja[5] = {J_auto[0], J_auto[1], J_auto[2], J_auto[3], J_auto[4]};
+    double* Jo[5] = {J_ours[0], J_ours[1], J_ours[2], J_ours[3], J_ours[4]};
+    ceres::AutoDiffCostFunction<gt::SweepPointToPlaneError, 1, 4, 3, 4, 3, 4> automatic(
+        new gt::SweepPointToPlaneError(e));
+    ASSERT_TRUE(automatic.Evaluate(params, &r_auto, Ja));
+    ASSERT_TRUE(gt::SweepPointToPlaneCost(e).Evaluate(params, &r_ours, Jo));
+    const double scale = std::abs(r_auto) + 1e3;  // w times the lever of 10 m
+    EXPECT_NEAR(r_ours, r_auto, 1e-9 * scale);
+    for (int b : {0, 2}) {
+      const double d = (tangent(params[b], J_ours[b]) - tangent(params[b], J_auto[b])).norm();
+      worst = std::max(worst, d / scale);
+      EXPECT_LT(d, 1e-7 * scale) << "trial " << trial << " rotation block " << b;
+    }
+    for (int b : {1, 3, 4}) {
+      for (int i = 0; i < (b == 4 ? 4 : 3); ++i)
+        EXPECT_NEAR(J_ours[b][i], J_auto[b][i], 1e-9 * scale) << "block " << b << " " << i;
+    }
+    // The rigid term, at knot a.
+    const gt::PointToPlaneError rigid{e.p_lidar, e.c_world, e.inv_sigma};
+    const double* rigid_params[3] = {params[0], params[1], params[4]};
+    double* Jra[3] = {J_auto[0], J_auto[1], J_auto[4]};
+    double* Jro[3] = {J_ours[0], J_ours[1], J_ours[4]};
+    ceres::AutoDiffCostFunction<gt::PointToPlaneError, 1, 4, 3, 4> rigid_automatic(
+        new gt::PointToPlaneError(rigid));
+    ASSERT_TRUE(rigid_automatic.Evaluate(rigid_params, &r_auto, Jra));
+    ASSERT_TRUE(gt::PointToPlaneCost(rigid).Evaluate(rigid_params, &r_ours, Jro));
+    EXPECT_NEAR(r_ours, r_auto, 1e-9 * scale);
+    EXPECT_LT((tangent(params[0], J_ours[0]) - tangent(params[0], J_auto[0])).norm(), 1e-7 * scale);
+    for (int i = 0; i < 4; ++i) EXPECT_NEAR(J_ours[4][i], J_auto[4][i], 1e-9 * scale);
+  }
+  std::printf("[ figures ] the largest tangent Jacobian difference, relative: %.2e\n", worst);
+}
 
 // Twenty sweeps of the simulator's hand-held calibration dance (angular rates to 3 rad/s),
 // deskewed with the true continuous motion and given without point times, every pose but the
