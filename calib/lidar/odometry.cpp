@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cctype>
 #include <chrono>
 #include <cmath>
@@ -28,7 +29,11 @@ Degeneracy degeneracy_of(const Matrix6d& covariance, const Matrix6d& information
   };
   d.rotation_ratio = block_ratio(information.topLeftCorner<3, 3>());
   d.translation_ratio = block_ratio(information.bottomRightCorner<3, 3>());
-  d.degenerate = d.rotation_ratio < ratio || d.translation_ratio < ratio;
+  const Eigen::Vector3d variances = trans.eigenvalues();
+  d.translation_variance_ratio =
+      variances(2) > 0 ? std::max(variances(0), 0.0) / variances(2) : 0.0;
+  d.degenerate = d.rotation_ratio < ratio || d.translation_ratio < ratio ||
+                 d.translation_variance_ratio < ratio;
   return d;
 }
 
@@ -76,6 +81,10 @@ Odometry start_odometry(const OdometryConfig& config) {
   o.config = config;
   o.map.voxel_size = config.voxel_size_m;
   o.map.max_points_per_voxel = config.max_points_per_voxel;
+  // KISS-ICP's spacing: a full voxel's points spread over it.
+  o.map.min_point_spacing =
+      config.voxel_size_m /
+      std::sqrt(static_cast<double>(std::max<size_t>(config.max_points_per_voxel, 1)));
   o.threshold.initial_m = config.initial_threshold_m;
   o.threshold.min_motion_m = config.min_motion_m;
   o.threshold.max_range_m = config.max_range_m;
@@ -183,6 +192,14 @@ Step register_scan(Odometry& o, const Scan& scan) {
          Eigen::Vector3d::Constant(c.step_sigma_floor_m * c.step_sigma_floor_m))
             .finished();
     step.degeneracy = degeneracy_of(step.covariance_prev_cur, r.information, c.degenerate_ratio);
+    Degeneracy& d = step.degeneracy;
+    if (c.degenerate_sigma_m > 0 && (d.translation_ratio < c.degenerate_ratio ||
+                                     d.translation_variance_ratio < c.degenerate_ratio)) {
+      step.covariance_prev_cur.bottomRightCorner<3, 3>() +=
+          c.degenerate_sigma_m * c.degenerate_sigma_m * d.weakest_translation *
+          d.weakest_translation.transpose();
+      d.translation_widened = true;
+    }
     step.correspondences = r.correspondences;
     step.residual_rms_m = r.residual_rms_m;
     step.noise_sigma_m = r.noise_sigma_m;

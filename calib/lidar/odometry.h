@@ -30,8 +30,13 @@ struct OdometryConfig {
   double sweep_motion_sigma_deg = 5.0, sweep_motion_sigma_m = 0.3;
   RegistrationConfig registration;
   // A step is called degenerate when the information's weakest direction holds less than this
-  // fraction of its strongest (translation and rotation blocks separately).
+  // fraction of its strongest (translation and rotation blocks separately), or the covariance's
+  // largest translation variance is more than its inverse times the smallest.
   double degenerate_ratio = 0.01;
+  // A step degenerate in translation gets this sigma (m) added along its weakest translation
+  // direction in its covariance: the scene does not see the motion there (a corridor), and the
+  // registration's own sigma would be far below its error (doc/odometry.md). 0 leaves it.
+  double degenerate_sigma_m = 1.0;
   // A sweep is skipped (no pose, the map unchanged) when fewer of its registration points than
   // this fraction, or than `min_correspondences`, find a plane of the map near the prediction:
   // it shares no surface with the map (a gap in the recording, a blocked sensor).
@@ -55,13 +60,18 @@ std::string preset_for_model(std::string_view model);
 
 // How well a step's registration constrains each direction: from its relative covariance, the
 // largest translation and rotation sigmas and their directions, and the information's weakest
-// over strongest eigenvalue per block.
+// over strongest eigenvalue per block; and the covariance's smallest over largest translation
+// variance (the marginal: the rotation's coupling and the residuals' clusters are in it).
 struct Degeneracy {
   double translation_sigma_max_m = 0, rotation_sigma_max_deg = 0;
   Eigen::Vector3d weakest_translation = Eigen::Vector3d::Zero();  // unit, previous sensor frame
   Eigen::Vector3d weakest_rotation = Eigen::Vector3d::Zero();
   double translation_ratio = 0, rotation_ratio = 0;
+  double translation_variance_ratio = 0;
   bool degenerate = false;
+  // The step's covariance was widened along weakest_translation (degenerate_sigma_m); the
+  // sigmas and ratios above are the registration's own, before it.
+  bool translation_widened = false;
 };
 
 struct Step {

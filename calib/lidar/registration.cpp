@@ -56,8 +56,9 @@ Normal<N> linearize(size_t count, const PointAt& point_at, const VoxelMap& map,
           const SweepPoint point = point_at(i);
           const Eigen::Vector3d a = T_odom_lidar.R * point.p;
           const Eigen::Vector3d q = a + T_odom_lidar.t;
-          const std::optional<Plane> plane = plane_near(
-              map, q, max_correspondence_m, config.plane_neighbours, config.max_flatness);
+          const std::optional<Plane> plane =
+              plane_near(map, q, max_correspondence_m, config.plane_neighbours, config.max_flatness,
+                         config.max_point_share);
           if (!plane) continue;
           const double r = plane->normal.dot(q - plane->point);
           if (std::abs(r) > max_correspondence_m) continue;

@@ -22,6 +22,9 @@ struct RegistrationConfig {
   double convergence = 1e-4;
   int plane_neighbours = 8;   // map points a plane is fitted to
   double max_flatness = 0.1;  // smallest over middle scatter eigenvalue of a plane's points
+  // The largest share of the middle scatter eigenvalue one of a plane's points may hold
+  // (plane_near): above it that point alone would set the normal's tilt.
+  double max_point_share = 0.35;
   // The covariance's clusters: cubes of this size (m) whose residuals may share an error; 0:
   // every residual independent.
   double cluster_size_m = 2.0;

@@ -198,8 +198,11 @@ nlohmann::json odometry_report(const OdometryRun& run) {
                  {"deskew", c.deskew},
                  {"deskew_passes", c.deskew_passes},
                  {"plane_neighbours", c.registration.plane_neighbours},
-                 {"degenerate_ratio", c.degenerate_ratio}};
-  size_t degenerate = 0, not_converged = 0, skipped = 0;
+                 {"max_flatness", c.registration.max_flatness},
+                 {"max_point_share", c.registration.max_point_share},
+                 {"degenerate_ratio", c.degenerate_ratio},
+                 {"degenerate_sigma_m", c.degenerate_sigma_m}};
+  size_t degenerate = 0, widened = 0, not_converged = 0, skipped = 0;
   double step_seconds = 0, max_seconds = 0;
   nlohmann::json rows = nlohmann::json::array();
   bool first = true;
@@ -219,6 +222,7 @@ nlohmann::json odometry_report(const OdometryRun& run) {
       continue;
     }
     degenerate += s.degeneracy.degenerate;
+    widened += s.degeneracy.translation_widened;
     not_converged += !s.converged;
     const Degeneracy& d = s.degeneracy;
     rows.push_back(
@@ -238,14 +242,17 @@ nlohmann::json odometry_report(const OdometryRun& run) {
          {"weakest_translation",
           {d.weakest_translation.x(), d.weakest_translation.y(), d.weakest_translation.z()}},
          {"translation_ratio", d.translation_ratio},
+         {"translation_variance_ratio", d.translation_variance_ratio},
          {"rotation_ratio", d.rotation_ratio},
          {"degenerate", d.degenerate},
+         {"translation_widened", d.translation_widened},
          {"seconds", s.seconds}});
   }
   j["summary"] = {
       {"scans", run.steps.size()},
       {"path_length_m", path_length(run.T_odom_lidar)},
       {"degenerate_steps", degenerate},
+      {"widened_steps", widened},
       {"not_converged_steps", not_converged},
       {"skipped_scans", skipped},
       {"seconds", run.seconds},

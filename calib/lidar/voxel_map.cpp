@@ -24,7 +24,13 @@ size_t point_count(const VoxelMap& map) {
 void add_points(VoxelMap& map, const std::vector<Eigen::Vector3d>& points_odom) {
   for (const Eigen::Vector3d& p : points_odom) {
     std::vector<Eigen::Vector3d>& voxel = map.voxels[voxel_of(p, map.voxel_size)];
-    if (voxel.size() < map.max_points_per_voxel) voxel.push_back(p);
+    if (voxel.size() >= map.max_points_per_voxel) continue;
+    const double spacing2 = map.min_point_spacing * map.min_point_spacing;
+    if (spacing2 > 0 && std::any_of(voxel.begin(), voxel.end(), [&](const Eigen::Vector3d& v) {
+          return (v - p).squaredNorm() < spacing2;
+        }))
+      continue;
+    voxel.push_back(p);
   }
 }
 
@@ -36,7 +42,7 @@ void remove_far(VoxelMap& map, const Eigen::Vector3d& origin_odom, double max_di
 }
 
 std::optional<Plane> plane_near(const VoxelMap& map, const Eigen::Vector3d& q, double max_distance,
-                                int neighbours, double max_flatness) {
+                                int neighbours, double max_flatness, double max_point_share) {
   constexpr int kMaxNeighbours = 16;
   const int k_wanted = std::clamp(neighbours, 5, kMaxNeighbours);
   // The k nearest, kept sorted by squared distance (insertion: k is small).
@@ -85,6 +91,33 @@ std::optional<Plane> plane_near(const VoxelMap& map, const Eigen::Vector3d& q, d
   // Points along a line (one scan ring on a far wall) fix no normal about the line: a normal
   // from them would constrain a direction the surface does not.
   if (lambda(1) < kMinSpread * lambda(2)) return std::nullopt;
+  // One point holding most of the spread across the major axis alone decides the normal's tilt
+  // about that axis: a scan line and a stray point of another surface (sparse rings at long
+  // range). Such a normal constrains a direction the surface does not (doc/odometry.md, the
+  // corridor). Without that point the others must still spread in two directions.
+  const Eigen::Vector3d middle = eigen.eigenvectors().col(1);
+  int lever = -1;
+  double lever_u2 = max_point_share * lambda(1);
+  for (int i = 0; i < k; ++i) {
+    const double u = middle.dot(*nearest[i].second - mean);
+    if (u * u > lever_u2) lever_u2 = u * u, lever = i;
+  }
+  if (lever >= 0) {
+    Eigen::Vector3d rest_mean = Eigen::Vector3d::Zero();
+    for (int i = 0; i < k; ++i)
+      if (i != lever) rest_mean += *nearest[i].second;
+    rest_mean /= k - 1;
+    Eigen::Matrix3d rest = Eigen::Matrix3d::Zero();
+    for (int i = 0; i < k; ++i) {
+      if (i == lever) continue;
+      const Eigen::Vector3d d = *nearest[i].second - rest_mean;
+      rest += d * d.transpose();
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> rest_eigen;
+    rest_eigen.computeDirect(rest, Eigen::EigenvaluesOnly);
+    const Eigen::Vector3d& mu = rest_eigen.eigenvalues();
+    if (mu(1) < kMinSpread * mu(2)) return std::nullopt;
+  }
   plane.normal = eigen.eigenvectors().col(0).normalized();
   plane.point = mean;
   return plane;

@@ -21,6 +21,10 @@ struct VoxelHash {
 struct VoxelMap {
   double voxel_size = 1.0;  // m
   size_t max_points_per_voxel = 20;
+  // A point closer than this to one of its voxel's points is not added: the same surface measured
+  // again from nearly the same place adds no geometry, only the range noise spread along the
+  // rays (KISS-ICP's spacing).
+  double min_point_spacing = 0.0;
   std::unordered_map<Eigen::Vector3i, std::vector<Eigen::Vector3d>, VoxelHash> voxels;
 };
 
@@ -40,10 +44,11 @@ struct Plane {
 };
 // The plane through the `neighbours` map points nearest q within `max_distance`, searched in the
 // 8 voxels around the voxel corner nearest q (all points within half a voxel of q); none when fewer
-// than 5 are found, they do not lie on a plane (flatness over `max_flatness`) or they lie along a
+// than 5 are found, they do not lie on a plane (flatness over `max_flatness`), they lie along a
 // line (the middle scatter eigenvalue under 0.05 of the largest: a normal about the line is not
-// determined).
+// determined), or one of them holds more than `max_point_share` of the middle eigenvalue (the
+// tilt about the line would be that one point's).
 std::optional<Plane> plane_near(const VoxelMap& map, const Eigen::Vector3d& q, double max_distance,
-                                int neighbours, double max_flatness);
+                                int neighbours, double max_flatness, double max_point_share = 1.0);
 
 }  // namespace rigcal::lidar
