@@ -15,6 +15,7 @@
 #include "rigcal/core/error.h"
 #include "rigcal/core/text.h"
 #include "rigcal/io/files.h"
+#include "rigcal/io/ros_messages.h"
 
 namespace rigcal::io {
 namespace {
@@ -34,18 +35,7 @@ void keep(std::vector<Eigen::Vector3d>& out, double x, double y, double z) {
   if (!no_return(x, y, z)) out.emplace_back(x, y, z);
 }
 
-// A field of a ROS PointCloud2 as vbr-devkit's .metadata.json lists it.
-struct Field {
-  std::string name;
-  size_t offset = 0;
-  int datatype = 0;  // sensor_msgs/PointField: 1 int8 .. 6 uint32, 7 float32, 8 float64
-  size_t count = 1;
-};
-
-size_t datatype_size(int t) {
-  static constexpr size_t sizes[] = {0, 1, 1, 2, 2, 4, 4, 4, 8};
-  return t >= 1 && t <= 8 ? sizes[t] : 0;
-}
+using Field = PointField;
 
 template <typename V>
 double load(const char* p) {
@@ -104,12 +94,13 @@ std::vector<Field> vbr_fields(const std::filesystem::path& bin, size_t& point_st
       Field x{f.at("name").get<std::string>(), whole_number(f.at("offset"), "offset"),
               static_cast<int>(std::min<size_t>(whole_number(f.at("datatype"), "datatype"), 99)),
               f.contains("count") ? whole_number(f.at("count"), "count") : size_t{1}};
-      if (datatype_size(x.datatype) == 0)
+      if (point_field_size(static_cast<uint8_t>(x.datatype)) == 0)
         throw Error(fmt::format("field '{}': datatype {} unknown", x.name, x.datatype));
       if (x.offset > kMaxRecordBytes || x.count > kMaxRecordBytes)
         throw Error(fmt::format("field '{}': offset {} or count {} past any record", x.name,
                                 x.offset, x.count));
-      extent = std::max(extent, x.offset + datatype_size(x.datatype) * x.count);
+      extent =
+          std::max(extent, x.offset + point_field_size(static_cast<uint8_t>(x.datatype)) * x.count);
       fields.push_back(x);
     }
   } catch (const nlohmann::json::exception& e) {
@@ -155,9 +146,7 @@ Scan read_bin(const std::filesystem::path& path, bool sidecar_times) {
       if (f.name == name) return &f;
     return nullptr;
   };
-  const Field *fx = find("x"), *fy = find("y"), *fz = find("z"), *ring = find("ring"),
-              *ft = find("t"), *fi = find("intensity"), *fr = find("reflectivity"),
-              *frange = find("range");
+  const Field *fx = find("x"), *fy = find("y"), *fz = find("z"), *ring = find("ring");
   // Full records? Both layouts may divide the file's size; the wrong one shows itself: KITTI
   // records read from full ones hold the driver's integer fields as tiny non-zero floats, full
   // records read from KITTI ones have rings in the tens of thousands.
@@ -193,28 +182,8 @@ Scan read_bin(const std::filesystem::path& path, bool sidecar_times) {
           path.string(), step));
     }
   }
+  if (full) return scan_from_records(data, step, fields, path.string());
   Scan scan;
-  if (full) {
-    scan.point_times = ft != nullptr;
-    scan.points.reserve(data.size() / step);
-    for (size_t k = 0; k < data.size(); k += step) {
-      const char* r = data.data() + k;
-      const double x = field_value(r, *fx), y = field_value(r, *fy), z = field_value(r, *fz);
-      if (no_return(x, y, z)) continue;
-      ScanPoint p;
-      p.p = Eigen::Vector3f(saturated<float>(x), saturated<float>(y), saturated<float>(z));
-      if (ft) {
-        const double t = field_value(r, *ft);
-        p.t_ns = saturated<int64_t>(ft->datatype >= 7 ? t * 1e9 : t);
-      }
-      if (fi) p.intensity = saturated<float>(field_value(r, *fi));
-      if (ring) p.ring = saturated<uint16_t>(field_value(r, *ring));
-      if (fr) p.reflectivity = saturated<uint16_t>(field_value(r, *fr));
-      if (frange) p.range_mm = saturated<uint32_t>(field_value(r, *frange));
-      scan.points.push_back(p);
-    }
-    return scan;
-  }
   if (data.size() % 16 != 0) {
     throw Error(fmt::format(
         "{}: {} bytes is not a whole number of KITTI points (4 float32 each){}", path.string(),
@@ -406,6 +375,53 @@ std::vector<Eigen::Vector3d> read_pcd(const std::filesystem::path& path) {
 }
 
 }  // namespace
+
+Scan scan_from_records(std::string_view data, size_t point_step,
+                       const std::vector<PointField>& fields, const std::string& what) {
+  auto find = [&](const char* name) -> const Field* {
+    for (const Field& f : fields)
+      if (f.name == name) return &f;
+    return nullptr;
+  };
+  const Field *fx = find("x"), *fy = find("y"), *fz = find("z"), *ring = find("ring"),
+              *ft = find("t"), *fi = find("intensity"), *fr = find("reflectivity"),
+              *frange = find("range");
+  if (!fx || !fy || !fz) throw Error(fmt::format("{}: the fields lack x, y or z", what));
+  for (const Field& f : fields) {
+    const size_t size =
+        f.datatype >= 1 && f.datatype <= 8 ? point_field_size(static_cast<uint8_t>(f.datatype)) : 0;
+    if (size == 0 || f.offset + size > point_step) {
+      throw Error(
+          fmt::format("{}: field '{}' (datatype {}, offset {}) is not inside the {}-byte "
+                      "record",
+                      what, f.name, f.datatype, f.offset, point_step));
+    }
+  }
+  if (point_step == 0 || data.size() % point_step != 0) {
+    throw Error(fmt::format("{}: {} bytes is not a whole number of {}-byte records", what,
+                            data.size(), point_step));
+  }
+  Scan scan;
+  scan.point_times = ft != nullptr;
+  scan.points.reserve(data.size() / point_step);
+  for (size_t k = 0; k < data.size(); k += point_step) {
+    const char* r = data.data() + k;
+    const double x = field_value(r, *fx), y = field_value(r, *fy), z = field_value(r, *fz);
+    if (no_return(x, y, z)) continue;
+    ScanPoint p;
+    p.p = Eigen::Vector3f(saturated<float>(x), saturated<float>(y), saturated<float>(z));
+    if (ft) {
+      const double t = field_value(r, *ft);
+      p.t_ns = saturated<int64_t>(ft->datatype >= 7 ? t * 1e9 : t);
+    }
+    if (fi) p.intensity = saturated<float>(field_value(r, *fi));
+    if (ring) p.ring = saturated<uint16_t>(field_value(r, *ring));
+    if (fr) p.reflectivity = saturated<uint16_t>(field_value(r, *fr));
+    if (frange) p.range_mm = saturated<uint32_t>(field_value(r, *frange));
+    scan.points.push_back(p);
+  }
+  return scan;
+}
 
 Scan read_scan(const std::filesystem::path& path) {
   const std::string ext = path.extension().string();

@@ -9,6 +9,8 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <filesystem>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "rigcal/core/scan.h"
@@ -29,5 +31,21 @@ std::vector<Eigen::Vector3d> read_point_cloud(const std::filesystem::path& path)
 // data/; PCD gives x y z. Without times, Scan::point_times is false. The stamp is left 0 (the
 // caller knows it from timestamps.txt). Points with no return are dropped as above.
 Scan read_scan(const std::filesystem::path& path);
+
+// A field of a point record, as sensor_msgs/PointField and vbr-devkit's .metadata.json list it:
+// datatype 1 int8 .. 6 uint32, 7 float32, 8 float64.
+struct PointField {
+  std::string name;
+  size_t offset = 0;
+  int datatype = 0;
+  size_t count = 1;
+};
+// Whole records of `point_step` bytes described by `fields` (x, y and z needed; t, intensity,
+// ring, reflectivity and range taken where present, as read_scan takes them from a full-record
+// .bin) as a scan, points with no return dropped; the stamp is left 0. Throws rigcal::Error
+// saying what is wrong (`what` names the source): x, y or z missing, a field past the record,
+// or data not a whole number of records.
+Scan scan_from_records(std::string_view data, size_t point_step,
+                       const std::vector<PointField>& fields, const std::string& what);
 
 }  // namespace rigcal::io

@@ -6,6 +6,7 @@
 #include <chrono>
 
 #include "rigcal/core/error.h"
+#include "rigcal/io/bag_scans.h"
 #include "rigcal/io/image_sets.h"
 #include "rigcal/io/ouster_metadata.h"
 #include "rigcal/io/ouster_pcap.h"
@@ -50,6 +51,11 @@ fs::path scans_folder(const fs::path& given, const report::Progress& progress) {
     return given;
   if (is_kitti_sequence(given)) return given;
   if (is_scan_topic(given / "ouster_points")) return given / "ouster_points";
+  // A bag, or a folder of bags, with a PointCloud2 topic: read as it streams. Bags of Ouster
+  // packets only are converted with the session (below).
+  if (const std::vector<fs::path> bags = io::ros1_bags_at(given);
+      !bags.empty() && !io::scan_topic(bags).empty())
+    return given;
   const io::Session s = io::read_session(given, progress);
   for (const fs::path& recording : {s.motion, s.lidar_camera}) {
     if (!recording.empty() && is_scan_topic(recording / "ouster_points"))
@@ -85,7 +91,9 @@ void keep(OdometryRun& run, Step step, const std::string& source) {
 
 struct ScanStream::Impl {
   fs::path scans;
-  std::unique_ptr<io::OusterPcapReader> capture;  // or the folder:
+  std::unique_ptr<io::OusterPcapReader> capture;  // or the bags:
+  std::unique_ptr<io::BagScanStream> bag;
+  std::string bag_topic;  // or the folder:
   io::StampedFolder folder;
   size_t without_times = 0;
 };
@@ -101,6 +109,15 @@ ScanStream::ScanStream(const fs::path& scans) : impl_(std::make_unique<Impl>()) 
                       scans.string(), json.filename().string(), scans.string()));
     }
     impl_->capture = std::make_unique<io::OusterPcapReader>(scans, io::read_ouster_metadata(json));
+  } else if (const std::vector<fs::path> bags = io::ros1_bags_at(scans); !bags.empty()) {
+    impl_->bag_topic = io::scan_topic(bags);
+    if (impl_->bag_topic.empty()) {
+      throw Error(
+          fmt::format("{}: no sensor_msgs/PointCloud2 topic in the bags (Ouster packets: "
+                      "rigcal convert them first)",
+                      scans.string()));
+    }
+    impl_->bag = std::make_unique<io::BagScanStream>(bags, impl_->bag_topic);
   } else {
     impl_->folder = stamped_scans(scans);
   }
@@ -114,6 +131,13 @@ std::optional<Scan> ScanStream::next() {
     read_ += scan.has_value();
     return scan;
   }
+  if (impl_->bag) {
+    std::optional<Scan> scan = impl_->bag->next();
+    if (scan && scan->points.empty())
+      throw Error(fmt::format("{}: no points", impl_->bag->source()));
+    if (scan) impl_->without_times += !scan->point_times, ++read_;
+    return scan;
+  }
   if (read_ >= impl_->folder.files.size()) return std::nullopt;
   const std::string& file = impl_->folder.files[read_];
   Scan scan = io::read_scan(file);
@@ -124,9 +148,13 @@ std::optional<Scan> ScanStream::next() {
   return scan;
 }
 
-size_t ScanStream::total() const { return impl_->capture ? 0 : impl_->folder.files.size(); }
+size_t ScanStream::total() const {
+  if (impl_->bag) return impl_->bag->total();
+  return impl_->capture ? 0 : impl_->folder.files.size();
+}
 
 std::string ScanStream::source() const {
+  if (impl_->bag) return impl_->bag->source();
   if (impl_->capture || read_ == 0) return impl_->scans.string();
   return impl_->folder.files[read_ - 1];
 }
@@ -140,7 +168,10 @@ std::vector<std::string> ScanStream::notes() const {
                     "{} packets skipped{}{}",
                     c.frames_complete, c.frames_incomplete, c.skipped_total(),
                     c.note.empty() ? "" : "; ", c.note));
-  } else if (impl_->without_times > 0) {
+  }
+  if (impl_->bag)
+    out.push_back(fmt::format("bags read as they stream: topic {}", impl_->bag_topic));
+  if (!impl_->capture && impl_->without_times > 0) {
     out.push_back(fmt::format(
         "{} of {} scans have no per-point times (KITTI points, PCD): they are used as measured, "
         "not deskewed",

@@ -18,18 +18,20 @@ namespace rigcal::lidar {
 
 // The scans a path given by the user stands for: an Ouster capture itself (CAPTURE.pcap, read as
 // it streams with CAPTURE.json beside it), a topic folder (data/ with .bin or .pcd and
-// timestamps.txt), else its ouster_points/ (a recording), else the ouster_points/ of the
-// session's motion recording, then of its lidar_camera recording (io::read_session: bags are
-// converted first); or a KITTI odometry sequence (velodyne/ and times.txt, read in place).
+// timestamps.txt), else its ouster_points/ (a recording), a ROS1 bag or a folder of bags with a
+// PointCloud2 topic (read as they stream, io/bag_scans.h), else the ouster_points/ of the
+// session's motion recording, then of its lidar_camera recording (io::read_session: bags of
+// Ouster packets are converted first); or a KITTI odometry sequence (velodyne/ and times.txt,
+// read in place).
 // Throws rigcal::Error saying what was looked for.
 std::filesystem::path scans_folder(const std::filesystem::path& given,
                                    const report::Progress& progress = {});
 
-// The scans of `scans` (a folder or a capture, as scans_folder gives), one at a time in stamp
-// order: a folder's stamps from its timestamps.txt (each sweep's first point, the time its
+// The scans of `scans` (a folder, a capture or bags, as scans_folder gives), one at a time in
+// stamp order: a folder's stamps from its timestamps.txt (each sweep's first point, the time its
 // per-point times count from), a capture's from the sensor (its first valid column's), the capture
-// assembled packet by packet as it streams. Throws rigcal::Error naming the file on a scan not
-// read.
+// assembled packet by packet as it streams; bags' from their messages' header stamps. Throws
+// rigcal::Error naming the file on a scan not read.
 class ScanStream {
  public:
   explicit ScanStream(const std::filesystem::path& scans);
@@ -38,7 +40,7 @@ class ScanStream {
   ScanStream& operator=(const ScanStream&) = delete;
   std::optional<Scan> next();
   size_t read() const { return read_; }
-  size_t total() const;        // of a folder; 0 for a capture (not known before the end)
+  size_t total() const;        // of a folder or bags; 0 for a capture (not known before the end)
   std::string source() const;  // the file of the last scan read, or the capture
   // What the stream saw that its reader should say: the scans without point times, a capture's
   // counters (once the stream is done).

@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
+#include "bag_writer.h"
 #include "cli_run.h"
 #include "fixtures.h"
 #include "odometry_honesty.h"
@@ -405,6 +406,66 @@ TEST_F(OdometryOnADrive, ScansReadWithTheirTimesOrSayTheyHaveNone) {
               std::string::npos)
         << e;
   }
+}
+
+// The drive's scans as the Ouster ROS driver publishes them (48-byte records on /ouster/points,
+// stamped with the sweep's start), in two bags split in the middle and beside them a second
+// PointCloud2 topic: `rigcal odometry` on the folder of bags reads them as they stream (nothing
+// in TMPDIR) and gives the trajectory it gives on the scans folder, to the last bit.
+TEST_F(OdometryOnADrive, BagsOfTheScansStreamToTheSameTrajectory) {
+  const io::StampedFolder f = io::read_stamped_folder(scans(), ".bin");
+  testing::bag::Recording r;
+  for (size_t k = 0; k < f.files.size(); ++k) {
+    const Scan scan = io::read_scan(f.files[k]);
+    std::vector<uint8_t> records(48 * scan.points.size(), 0);
+    for (size_t i = 0; i < scan.points.size(); ++i) {
+      uint8_t* rec = records.data() + 48 * i;
+      const ScanPoint& p = scan.points[i];
+      const uint32_t t = static_cast<uint32_t>(p.t_ns);
+      std::memcpy(rec, p.p.data(), 12);
+      std::memcpy(rec + 16, &p.intensity, 4);
+      std::memcpy(rec + 20, &t, 4);
+      std::memcpy(rec + 26, &p.ring, 2);
+    }
+    r.clouds.push_back({"/ouster/points", f.stamps[k].ns, records});
+    if (k % 5 == 0) r.clouds.push_back({"/ouster/range_image_cloud", f.stamps[k].ns, records});
+  }
+  const fs::path bags = *dir_ / "bags", tmp = *dir_ / "tmp";
+  fs::create_directories(bags);
+  fs::create_directories(tmp);
+  testing::bag::write_split_bags((bags / "drive").string(), r);
+  const OdometryRun on_folder = run_odometry(scans(), os0_128_handheld());
+  ASSERT_EQ(scans_folder(bags), bags);
+  const OdometryRun on_bags = run_odometry(bags, os0_128_handheld());
+  ASSERT_EQ(on_bags.T_odom_lidar.size(), f.files.size());
+  EXPECT_EQ(on_bags.T_odom_lidar.stamps, on_folder.T_odom_lidar.stamps);
+  for (size_t k = 0; k < f.files.size(); ++k) {
+    EXPECT_EQ(on_bags.T_odom_lidar.T_world_body[k].t, on_folder.T_odom_lidar.T_world_body[k].t);
+    EXPECT_EQ(on_bags.T_odom_lidar.T_world_body[k].R, on_folder.T_odom_lidar.T_world_body[k].R);
+  }
+  EXPECT_NE(std::find(on_bags.notes.begin(), on_bags.notes.end(),
+                      "bags read as they stream: topic /ouster/points"),
+            on_bags.notes.end());
+  // The command on one bag of the two (its half of the drive), and nothing in TMPDIR.
+  const testing::CliRun c =
+      testing::rigcal_cli(fmt::format("odometry {} --out {}", (bags / "drive_0.bag").string(),
+                                      (*dir_ / "half.tum").string()),
+                          *dir_, fmt::format("TMPDIR={}", tmp.string()));
+  EXPECT_EQ(c.status, 0) << c.out << c.err;
+  EXPECT_TRUE(fs::is_empty(tmp));
+  const Trajectory half = io::read_trajectory(*dir_ / "half.tum").trajectory;
+  EXPECT_GT(half.size(), 5u);
+  EXPECT_LT(half.size(), f.files.size());
+  EXPECT_EQ(half.stamps.front(), f.stamps.front());
+  // Two PointCloud2 topics and neither the driver's: which to take is the user's to say.
+  testing::bag::Recording two;
+  for (const char* topic : {"/left/cloud", "/right/cloud"})
+    two.clouds.push_back({topic, f.stamps[0].ns, r.clouds[0].records});
+  fs::create_directories(*dir_ / "two");
+  testing::bag::write_split_bags((*dir_ / "two" / "two").string(), two);
+  const std::string e =
+      testing::error_message_of([&] { run_odometry(*dir_ / "two", os0_128_handheld()); });
+  EXPECT_NE(e.find("2 PointCloud2 topics (/left/cloud, /right/cloud)"), std::string::npos) << e;
 }
 
 // Points scattered in a ball of 30 m around the sensor: no surface, nothing of the map's.
