@@ -41,7 +41,11 @@ void run(const Options& o) {
   files[0].content = io::trajectory_to_tum(run.T_odom_lidar);
   files[1].content = io::step_covariances_to_text(lidar::step_covariances(run));
   const nlohmann::json report = lidar::odometry_report(run);
-  if (!o.report.empty()) files[2].content = report.dump(1) + "\n";
+  if (!o.report.empty()) {
+    files[2].content = report.dump(1) + "\n";
+    for (auto& [name, svg] : lidar::odometry_figures(report))
+      files.push_back({o.report + "/" + name, std::move(svg)});
+  }
   io::write_files_atomic(files);
 
   const nlohmann::json& summary = report["summary"];
@@ -54,7 +58,9 @@ void run(const Options& o) {
              summary["not_converged_steps"].get<size_t>(), summary["skipped_scans"].get<size_t>());
   for (const std::string& n : run.notes) fmt::print("note: {}\n", n);
   fmt::print("wrote {} (T_odom_lidar at each scan's stamp, TUM) and {}{}\n", o.out, covariances,
-             o.report.empty() ? "" : fmt::format("; report {}/odometry.json", o.report));
+             o.report.empty()
+                 ? ""
+                 : fmt::format("; report {}/odometry.json and its figures (.svg)", o.report));
 }
 
 }  // namespace
@@ -75,7 +81,9 @@ void add_odometry(CLI::App& app) {
   cmd->add_option("--out", o->out, "output trajectory (TUM)")->required();
   cmd->add_option("--covariances", o->covariances,
                   "output step covariances (default: OUT without extension + _covariances.txt)");
-  cmd->add_option("--report", o->report, "report folder: odometry.json, one row a step");
+  cmd->add_option("--report", o->report,
+                  "report folder: odometry.json (one row a step) and its figures: residuals, "
+                  "inliers, degeneracy, timing (.svg)");
   cmd->add_option("--sensor", o->sensor,
                   "preset: os0-128 (hand-held, 0.5 m voxels, 50 m) | os1-64 (car, 1 m, 100 m)")
       ->check(CLI::IsMember(lidar::preset_names()))

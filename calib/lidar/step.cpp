@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "rigcal/core/error.h"
 #include "rigcal/io/bag_scans.h"
@@ -12,6 +13,7 @@
 #include "rigcal/io/ouster_pcap.h"
 #include "rigcal/io/point_cloud_io.h"
 #include "rigcal/io/session.h"
+#include "rigcal/report/svg_plot.h"
 
 namespace rigcal::lidar {
 
@@ -306,6 +308,50 @@ std::string choose_preset(const std::string& given, const rig::Sensor* lidar,
                     lidar->model));
   }
   return "os0-128";
+}
+
+std::vector<std::pair<std::string, std::string>> odometry_figures(const nlohmann::json& report) {
+  const nlohmann::json& rows = report.at("steps");
+  double t0 = 0;
+  for (const nlohmann::json& r : rows) {
+    t0 = r.at("t").get<double>();
+    break;
+  }
+  // One series a key of the registered steps' rows, scaled, against the time since the first.
+  auto series = [&](const std::string& label, const char* key, double scale, bool log10) {
+    report::PlotSeries s{label, {}, {}, {}};
+    for (const nlohmann::json& r : rows) {
+      if (r.contains("skipped") || !r.contains(key)) continue;
+      const double v = r.at(key).get<double>() * scale;
+      if (log10 && !(v > 0)) continue;
+      s.x.push_back(r.at("t").get<double>() - t0);
+      s.y.push_back(log10 ? std::log10(v) : v);
+    }
+    return s;
+  };
+  const std::string x_label = "time since the first scan (s)";
+  std::vector<std::pair<std::string, std::string>> out;
+  auto add = [&](const std::string& file, const std::string& title, const std::string& y_label,
+                 std::vector<report::PlotSeries> s) {
+    report::Plot p;
+    p.title = title, p.x_label = x_label, p.y_label = y_label, p.series = std::move(s);
+    out.emplace_back(file, report::render_svg(p));
+  };
+  add("residuals.svg", "Point-to-plane residuals of each step", "mm",
+      {series("rms of the correspondences", "residual_rms_m", 1e3, false),
+       series("noise level (weighted)", "noise_sigma_m", 1e3, false)});
+  add("inliers.svg", "Registration points with a map plane within the threshold",
+      "fraction of the points used", {series("inlier ratio", "inlier_ratio", 1, false)});
+  report::PlotSeries threshold = series("degenerate below", "translation_ratio", 1, true);
+  const double ratio = report.at("config").value("degenerate_ratio", 0.01);
+  for (double& y : threshold.y) y = std::log10(ratio);
+  add("degeneracy.svg", "Weakest over strongest direction (1: even, small: degenerate)",
+      "log10 ratio",
+      {series("translation, information", "translation_ratio", 1, true),
+       series("translation, covariance", "translation_variance_ratio", 1, true),
+       series("rotation, information", "rotation_ratio", 1, true), threshold});
+  add("timing.svg", "Wall time of each step", "ms", {series("step", "seconds", 1e3, false)});
+  return out;
 }
 
 }  // namespace rigcal::lidar

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "rigcal/core/scan.h"
@@ -83,5 +84,10 @@ std::string choose_preset(const std::string& given, const rig::Sensor* lidar,
 // The report: the configuration, a summary (frames, path length, timing, degenerate steps) and
 // one row a step (doc/odometry.md says what each number is).
 nlohmann::json odometry_report(const OdometryRun& run);
+
+// The report's figures, rendered from its rows alone (so a stored odometry.json renders again):
+// file name and SVG text of each: the residuals and noise level a step (mm), the inlier ratio,
+// the degeneracy ratios (log10, with the threshold) and the time a step (ms), over the scans' time.
+std::vector<std::pair<std::string, std::string>> odometry_figures(const nlohmann::json& report);
 
 }  // namespace rigcal::lidar

@@ -581,6 +581,14 @@ TEST_F(OdometryOnADrive, TheCommandWritesAllOrNothingAndNamesBadInput) {
       nlohmann::json::parse(testing::slurp(out / "report" / "odometry.json"));
   EXPECT_EQ(report["steps"].size(), 14u);
   EXPECT_EQ(report["summary"]["scans"], 15);
+  // The figures, as the stored report renders them again.
+  const auto figures = odometry_figures(report);
+  ASSERT_EQ(figures.size(), 4u);
+  for (const auto& [name, svg] : figures) {
+    EXPECT_EQ(testing::slurp(out / "report" / name), svg) << name;
+    EXPECT_NE(svg.find("time since the first scan (s)"), std::string::npos) << name;
+  }
+  EXPECT_NE(figures[0].second.find("Point-to-plane residuals"), std::string::npos);
 
   const testing::CliRun none = testing::rigcal_cli(
       fmt::format("odometry {} --out {}", (out / "report").string(), (out / "x.tum").string()),
