@@ -5,12 +5,16 @@
 // plane estimated with them: its unit normal n and its offset d from an anchor point c (the
 // patch's centroid when it was found), the plane {x : n . (x - c) = d}.
 //
-// PointToPlaneError defines the residual; PointToPlaneCost evaluates it with its Jacobians
-// written out (as SweepPointToPlaneCost, checked against the automatic ones in the tests).
-#include <ceres/sized_cost_function.h>
+// PointToPlaneError defines the residual; PlanePointsCost evaluates it for several points with
+// its Jacobians written out (as SweepPlanePointsCost, checked against the automatic ones in the
+// tests).
+#include <ceres/cost_function.h>
+#include <ceres/manifold.h>
+#include <ceres/product_manifold.h>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <vector>
 
 namespace rigcal::gt {
 
@@ -31,15 +35,28 @@ struct PointToPlaneError {
   }
 };
 
-// Parameter blocks: q_world_lidar (EigenQuaternionManifold), t_world_lidar, plane (n then d).
-class PointToPlaneCost final : public ceres::SizedCostFunction<1, 4, 3, 4> {
+// A knot of the adjustment as one parameter block of 7: T_world_lidar's Eigen quaternion (x y z
+// w), then its translation; its manifold KnotManifold (tangent: half the world-frame rotation
+// vector, then the translation).
+using KnotManifold =
+    ceres::ProductManifold<ceres::EigenQuaternionManifold, ceres::EuclideanManifold<3>>;
+
+// The points of one scan that lie on one plane, all at one knot (PointToPlaneError each, one
+// residual a point): parameter blocks the knot (7) and the plane (n then d, 4). One block for
+// them all keeps the solver's per-block work to one a scan and plane.
+class PlanePointsCost final : public ceres::CostFunction {
  public:
-  explicit PointToPlaneCost(const PointToPlaneError& e) : e_(e) {}
+  // `huber`: each point's residual (in sigmas) through Huber's loss at that scale (0: none),
+  // folded into the residual so that the block's cost is the sum of the points' losses.
+  PlanePointsCost(std::vector<Eigen::Vector3d> p_lidar, const Eigen::Vector3d& c_world,
+                  double inv_sigma, double huber = 0);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
  private:
-  PointToPlaneError e_;
+  std::vector<Eigen::Vector3d> p_lidar_;
+  Eigen::Vector3d c_world_;
+  double inv_sigma_, huber_;
 };
 
 }  // namespace rigcal::gt

@@ -6,14 +6,15 @@
 // pose at its fraction f of the way and measured against its plane as PointToPlaneError.
 //
 // SweepPointToPlaneError defines the residual (any scalar type, for automatic differentiation);
-// SweepPointToPlaneCost evaluates the same residual with its Jacobians written out (the solver's
-// inner loop: several times faster than the automatic ones, and checked against them in the
-// tests).
+// SweepPlanePointsCost evaluates it for the points of a scan on a plane with its Jacobians
+// written out (the solver's inner loop: several times faster than the automatic ones, and
+// checked against them in the tests).
+#include <ceres/cost_function.h>
 #include <ceres/rotation.h>
-#include <ceres/sized_cost_function.h>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <vector>
 
 namespace rigcal::gt {
 
@@ -45,20 +46,29 @@ struct SweepPointToPlaneError {
   }
 };
 
-// Parameter blocks: q_world_a (Eigen x y z w, EigenQuaternionManifold), t_world_a, q_world_b,
-// t_world_b, plane (n then d). The rotations' Jacobians are taken in the world-frame rotation
-// theta of each knot (R -> Exp(theta) R): with R_f = R_a Exp(f phi), phi = Log(R_a' R_b) and
+// The points of one scan on one plane measured between knots a and b (SweepPointToPlaneError
+// each, one residual a point): parameter blocks knot a, knot b (7 each, KnotManifold) and the
+// plane (n then d). The rotations' Jacobians are taken in the world-frame rotation theta of each
+// knot (R -> Exp(theta) R): with R_f = R_a Exp(f phi), phi = Log(R_a' R_b) and
 // A = f J_r(f phi) J_r(phi)^-1, the point R_f p moves by -[R_f p]x theta_a - R_f [p]x A R_b'
 // (theta_b - theta_a). Ceres' quaternion tangent is theta / 2, and its ambient Jacobian is the
 // tangent one times the manifold's PlusJacobian transposed (orthonormal columns at a unit q).
-class SweepPointToPlaneCost final : public ceres::SizedCostFunction<1, 4, 3, 4, 3, 4> {
+class SweepPlanePointsCost final : public ceres::CostFunction {
  public:
-  explicit SweepPointToPlaneCost(const SweepPointToPlaneError& e) : e_(e) {}
+  struct Point {
+    Eigen::Vector3d p_lidar;
+    double fraction = 0;
+  };
+  // `huber` as PlanePointsCost's.
+  SweepPlanePointsCost(std::vector<Point> points, const Eigen::Vector3d& c_world, double inv_sigma,
+                       double huber = 0);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
  private:
-  SweepPointToPlaneError e_;
+  std::vector<Point> points_;
+  Eigen::Vector3d c_world_;
+  double inv_sigma_, huber_;
 };
 
 }  // namespace rigcal::gt

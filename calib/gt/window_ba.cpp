@@ -2,9 +2,11 @@
 
 #include <ceres/ceres.h>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <memory>
 #include <thread>
 #include <unordered_map>
@@ -106,61 +108,105 @@ double rms_distance(const Associations& a,
   return std::sqrt(sum / double(a.points.size()));
 }
 
+// A knot as its parameter block: the quaternion (x y z w), then the translation.
+using Knot = Eigen::Matrix<double, 7, 1>;
+Knot knot_of(const SE3& T) {
+  Knot k;
+  k.head<4>() = Eigen::Quaterniond(T.R).normalized().coeffs();
+  k.tail<3>() = T.t;
+  return k;
+}
+SE3 knot_pose(const Knot& k) {
+  return SE3::from_quaternion(Eigen::Quaterniond(k[3], k[0], k[1], k[2]).normalized(), k.tail<3>());
+}
+
 int threads(const WindowBaConfig& config) {
   return config.threads > 0 ? config.threads
                             : int(std::max(1u, std::thread::hardware_concurrency()));
 }
 
 // The motion's covariance between consecutive scan knots (`scan_knots`, indices into the internal
-// knots), from the joint tangent covariance of their blocks. Ceres' quaternion tangent d is half
-// the rotation vector (exp(2 d) R, on the left, in the world frame); the translation's is the
-// world's. With the knots perturbed so (phi, dt), the motion R_a' R_b, R_a' (t_b - t_a) is
-// perturbed by e_rot = R_a' (phi_b - phi_a) and e_t = R_a' (dt_b - dt_a) + R_a' [t_b - t_a]x phi_a,
-// to first order.
-std::vector<Matrix6d> step_covariances(ceres::Problem& problem, int threads,
-                                       std::vector<Eigen::Quaterniond>& q,
-                                       std::vector<Eigen::Vector3d>& t,
+// knots): the information of the knots from the last solve's Jacobian, the planes eliminated
+// (each plane's 3 x 3 block, its Schur complement onto the knots it touches), inverted with the
+// held first knot left out. A knot's tangent (KnotManifold) is half the rotation vector (exp(2 d)
+// R, on the left, in the world frame), then the world's translation. With the knots perturbed so
+// (phi, dt), the motion R_a' R_b, R_a' (t_b - t_a) is perturbed by e_rot = R_a' (phi_b - phi_a)
+// and e_t = R_a' (dt_b - dt_a) + R_a' [t_b - t_a]x phi_a, to first order. Empty when a knot has
+// no residual or the information is singular.
+std::vector<Matrix6d> step_covariances(ceres::Problem& problem, std::vector<Knot>& x,
+                                       const std::vector<Eigen::Vector4d*>& planes,
                                        const std::vector<size_t>& scan_knots, double scale) {
-  const size_t knots = scan_knots.size();
-  std::vector<const double*> blocks;
-  for (size_t j = 0; j < q.size(); ++j)
-    if (!problem.HasParameterBlock(q[j].coeffs().data())) return {};
-  for (size_t k : scan_knots) {
-    blocks.push_back(q[k].coeffs().data());
-    blocks.push_back(t[k].data());
+  const size_t free_knots = x.size() - 1;  // knot 0 is held
+  ceres::Problem::EvaluateOptions options;
+  for (size_t k = 1; k < x.size(); ++k) {
+    if (!problem.HasParameterBlock(x[k].data())) return {};
+    options.parameter_blocks.push_back(x[k].data());
   }
-  std::vector<std::pair<const double*, const double*>> pairs;  // each once
-  for (size_t k = 0; k + 1 < knots; ++k)
-    for (size_t i = 2 * k; i < 2 * k + 4; ++i)
-      for (size_t j = std::max(i, 2 * k + 2); j < 2 * k + 4; ++j)
-        pairs.push_back({blocks[i], blocks[j]});
-  for (size_t i = 0; i < 2; ++i)  // the first knot's own blocks (the others' come with k - 1)
-    for (size_t j = i; j < 2; ++j) pairs.push_back({blocks[i], blocks[j]});
-  ceres::Covariance::Options options;
-  options.algorithm_type = ceres::SPARSE_QR;
-  options.num_threads = threads;
-  ceres::Covariance covariance(options);
-  if (!covariance.Compute(pairs, &problem)) return {};
-  std::vector<Matrix6d> out;
-  for (size_t k = 0; k + 1 < knots; ++k) {
-    Eigen::Matrix<double, 12, 12> S;
-    for (size_t i = 0; i < 4; ++i) {
-      for (size_t j = i; j < 4; ++j) {
-        Eigen::Matrix<double, 3, 3, Eigen::RowMajor> c;
-        covariance.GetCovarianceBlockInTangentSpace(blocks[2 * k + i], blocks[2 * k + j], c.data());
-        S.block<3, 3>(3 * i, 3 * j) = c;
-        S.block<3, 3>(3 * j, 3 * i) = c.transpose();
+  for (Eigen::Vector4d* p : planes) options.parameter_blocks.push_back(p->data());
+  ceres::CRSMatrix J;
+  if (!problem.Evaluate(options, nullptr, nullptr, nullptr, &J)) return {};
+  const int knot_columns = int(6 * free_knots);
+  // Per plane: its own block, and its rows' products with the knots' columns it touches.
+  struct PlaneInfo {
+    Eigen::Matrix3d Hpp = Eigen::Matrix3d::Zero();
+    std::map<int, Eigen::Vector3d> Hpk;  // knot column -> 3 x 1
+  };
+  std::vector<PlaneInfo> info(planes.size());
+  Eigen::MatrixXd S = Eigen::MatrixXd::Zero(knot_columns, knot_columns);
+  std::vector<std::pair<int, double>> knot_part;
+  for (int r = 0; r < J.num_rows; ++r) {
+    knot_part.clear();
+    int plane = -1;
+    Eigen::Vector3d jp = Eigen::Vector3d::Zero();
+    for (int i = J.rows[r]; i < J.rows[r + 1]; ++i) {
+      const int c = J.cols[i];
+      if (c < knot_columns) {
+        knot_part.push_back({c, J.values[i]});
+      } else {
+        plane = (c - knot_columns) / 3;
+        jp[(c - knot_columns) % 3] = J.values[i];
       }
     }
+    for (const auto& [c1, v1] : knot_part)
+      for (const auto& [c2, v2] : knot_part) S(c1, c2) += v1 * v2;
+    if (plane < 0) continue;
+    info[plane].Hpp += jp * jp.transpose();
+    for (const auto& [c, v] : knot_part) {
+      auto [it, inserted] = info[plane].Hpk.try_emplace(c, v * jp);
+      if (!inserted) it->second += v * jp;
+    }
+  }
+  for (const PlaneInfo& p : info) {
+    const Eigen::LDLT<Eigen::Matrix3d> ldlt(p.Hpp);
+    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0)) continue;
+    std::vector<int> cols;
+    Eigen::Matrix<double, 3, Eigen::Dynamic> B(3, p.Hpk.size());
+    for (const auto& [c, v] : p.Hpk) B.col(Eigen::Index(cols.size())) = v, cols.push_back(c);
+    const Eigen::MatrixXd update = B.transpose() * ldlt.solve(B);
+    for (size_t i = 0; i < cols.size(); ++i)
+      for (size_t j = 0; j < cols.size(); ++j) S(cols[i], cols[j]) -= update(i, j);
+  }
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(S);
+  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0)) return {};
+  const Eigen::MatrixXd C = ldlt.solve(Eigen::MatrixXd::Identity(knot_columns, knot_columns));
+  auto block = [&](size_t i, size_t j) -> Matrix6d {  // of knots i, j (0: held, zero)
+    if (i == 0 || j == 0) return Matrix6d::Zero();
+    return C.block<6, 6>(6 * Eigen::Index(i - 1), 6 * Eigen::Index(j - 1));
+  };
+  std::vector<Matrix6d> out;
+  for (size_t k = 0; k + 1 < scan_knots.size(); ++k) {
     const size_t a = scan_knots[k], b = scan_knots[k + 1];
-    const Eigen::Matrix3d Rt = q[a].normalized().toRotationMatrix().transpose();
-    Eigen::Matrix<double, 6, 12> J = Eigen::Matrix<double, 6, 12>::Zero();
-    J.block<3, 3>(0, 0) = -2.0 * Rt;
-    J.block<3, 3>(0, 6) = 2.0 * Rt;
-    J.block<3, 3>(3, 0) = 2.0 * Rt * skew(t[b] - t[a]);
-    J.block<3, 3>(3, 3) = -Rt;
-    J.block<3, 3>(3, 9) = Rt;
-    out.push_back(scale * J * S * J.transpose());
+    Eigen::Matrix<double, 12, 12> joint;
+    joint << block(a, a), block(a, b), block(b, a), block(b, b);
+    const Eigen::Matrix3d Rt = knot_pose(x[a]).R.transpose();
+    const Eigen::Vector3d ta = x[a].tail<3>(), tb = x[b].tail<3>();
+    Eigen::Matrix<double, 6, 12> M = Eigen::Matrix<double, 6, 12>::Zero();
+    M.block<3, 3>(0, 0) = -2.0 * Rt;
+    M.block<3, 3>(0, 6) = 2.0 * Rt;
+    M.block<3, 3>(3, 0) = 2.0 * Rt * skew(tb - ta);
+    M.block<3, 3>(3, 3) = -Rt;
+    M.block<3, 3>(3, 9) = Rt;
+    out.push_back(scale * M * joint * M.transpose());
   }
   return out;
 }
@@ -212,12 +258,8 @@ WindowBaResult window_ba(const std::vector<Scan>& scans, const std::vector<SE3>&
   }
 
   const size_t knots = T_world_knot.size();
-  std::vector<Eigen::Quaterniond> q(knots);
-  std::vector<Eigen::Vector3d> t(knots);
-  for (size_t k = 0; k < knots; ++k) {
-    q[k] = Eigen::Quaterniond(T_world_knot[k].R).normalized();
-    t[k] = T_world_knot[k].t;
-  }
+  std::vector<Knot> x(knots);
+  for (size_t k = 0; k < knots; ++k) x[k] = knot_of(T_world_knot[k]);
   std::unique_ptr<ceres::Problem> last;  // the last round's, for the covariances
   std::vector<Eigen::Vector4d> plane;
   for (out.rounds = 0; out.rounds < config.rounds;) {
@@ -236,19 +278,30 @@ WindowBaResult window_ba(const std::vector<Scan>& scans, const std::vector<SE3>&
     last = std::make_unique<ceres::Problem>();
     ceres::Problem& problem = *last;
     auto* ordering = new ceres::ParameterBlockOrdering;
+    // One residual block a plane and knot: the points of one scan (or two, where a sweep's
+    // knots meet) on one plane, measured from that knot on.
+    std::map<std::pair<uint32_t, uint32_t>, std::vector<const SweepPoint*>> groups;
     for (const Association& r : a.points) {
       const SweepPoint& p = points[r.scan][r.index];
-      const Eigen::Vector3d& c = a.planes[r.plane].centroid;
-      const double w = 1.0 / config.point_sigma_m;
-      auto* loss = new ceres::HuberLoss(config.huber_sigmas);
-      const size_t k = p.knot;
-      if (p.fraction == 0) {
-        problem.AddResidualBlock(new PointToPlaneCost({p.p_lidar, c, w}), loss,
-                                 q[k].coeffs().data(), t[k].data(), plane[r.plane].data());
+      groups[{r.plane, p.knot}].push_back(&p);
+    }
+    const double w = 1.0 / config.point_sigma_m;
+    for (const auto& [key, members] : groups) {
+      const auto [j, k] = key;
+      const Eigen::Vector3d& c = a.planes[j].centroid;
+      const bool moving = std::any_of(members.begin(), members.end(),
+                                      [](const SweepPoint* p) { return p->fraction != 0; });
+      if (!moving) {
+        std::vector<Eigen::Vector3d> p_lidar;
+        for (const SweepPoint* p : members) p_lidar.push_back(p->p_lidar);
+        problem.AddResidualBlock(new PlanePointsCost(std::move(p_lidar), c, w, config.huber_sigmas),
+                                 nullptr, x[k].data(), plane[j].data());
       } else {
-        problem.AddResidualBlock(new SweepPointToPlaneCost({p.p_lidar, p.fraction, c, w}), loss,
-                                 q[k].coeffs().data(), t[k].data(), q[k + 1].coeffs().data(),
-                                 t[k + 1].data(), plane[r.plane].data());
+        std::vector<SweepPlanePointsCost::Point> sweep;
+        for (const SweepPoint* p : members) sweep.push_back({p->p_lidar, p->fraction});
+        problem.AddResidualBlock(
+            new SweepPlanePointsCost(std::move(sweep), c, w, config.huber_sigmas), nullptr,
+            x[k].data(), x[k + 1].data(), plane[j].data());
       }
     }
     for (size_t j = 0; j < a.planes.size(); ++j) {
@@ -258,19 +311,15 @@ WindowBaResult window_ba(const std::vector<Scan>& scans, const std::vector<SE3>&
       ordering->AddElementToGroup(plane[j].data(), 0);
     }
     for (size_t k = 0; k < knots; ++k) {
-      if (!problem.HasParameterBlock(q[k].coeffs().data())) continue;
-      problem.SetManifold(q[k].coeffs().data(), new ceres::EigenQuaternionManifold);
-      ordering->AddElementToGroup(q[k].coeffs().data(), 1);
-      ordering->AddElementToGroup(t[k].data(), 1);
+      if (!problem.HasParameterBlock(x[k].data())) continue;
+      problem.SetManifold(x[k].data(), new KnotManifold);
+      ordering->AddElementToGroup(x[k].data(), 1);
     }
-    if (problem.HasParameterBlock(q[0].coeffs().data())) {
-      problem.SetParameterBlockConstant(q[0].coeffs().data());
-      problem.SetParameterBlockConstant(t[0].data());
-    }
+    if (problem.HasParameterBlock(x[0].data())) problem.SetParameterBlockConstant(x[0].data());
     ceres::Solver::Options options;
     options.linear_solver_type = ceres::DENSE_SCHUR;  // the planes eliminated, the poses solved
     options.linear_solver_ordering.reset(ordering);
-    options.max_num_iterations = config.max_iterations;
+    options.max_num_iterations = out.rounds == 1 ? config.max_iterations : config.later_iterations;
     options.num_threads = threads(config);
     ceres::Solver::Summary summary;
     ceres::Solve(options, &problem, &summary);
@@ -278,8 +327,8 @@ WindowBaResult window_ba(const std::vector<Scan>& scans, const std::vector<SE3>&
       throw Error("window bundle adjustment: the solve failed: " + summary.message);
     double moved = 0;
     for (size_t k = 1; k < knots; ++k) {
-      if (!problem.HasParameterBlock(q[k].coeffs().data())) continue;
-      const SE3 T = SE3::from_quaternion(q[k].normalized(), t[k]);
+      if (!problem.HasParameterBlock(x[k].data())) continue;
+      const SE3 T = knot_pose(x[k]);
       moved = std::max({moved, (T.t - T_world_knot[k].t).norm(),
                         10.0 * rotation_angle(T.R * T_world_knot[k].R.transpose())});
       T_world_knot[k] = T;
@@ -293,8 +342,11 @@ WindowBaResult window_ba(const std::vector<Scan>& scans, const std::vector<SE3>&
   out.rms_after_m = rms_distance(associate(world, config), world);
   if (config.step_covariances && last) {
     const double variance = std::pow(out.rms_after_m / config.point_sigma_m, 2);
+    std::vector<Eigen::Vector4d*> plane_blocks;
+    for (Eigen::Vector4d& p : plane)
+      if (last->HasParameterBlock(p.data())) plane_blocks.push_back(&p);
     out.step_covariance =
-        step_covariances(*last, threads(config), q, t, scan_knot, std::max(1.0, variance));
+        step_covariances(*last, x, plane_blocks, scan_knot, std::max(1.0, variance));
   }
   return out;
 }

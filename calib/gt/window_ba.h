@@ -41,7 +41,11 @@ struct WindowBaConfig {
   double point_sigma_m = 0.01;  // the points' noise along a normal (the range noise)
   double huber_sigmas = 3.0;    // Huber scale of the point-to-plane residual, in point sigmas
   int rounds = 4;               // map rebuilt and solved again, at most
-  int max_iterations = 15;      // of each round's solve
+  int max_iterations = 15;      // of the first round's solve
+  // Of each later round's: it starts near its optimum (the association changes little), and
+  // the solver otherwise spends up to max_iterations on millimetres (the demo's walk: the same
+  // ground truth, 28 % less time).
+  int later_iterations = 4;
   // Rounds stop when no pose moved more than this (m, and the same in rad over 10 m).
   double converged_m = 1e-4;
   // The covariance of each motion between consecutive knots (WindowBaResult::step_covariance).

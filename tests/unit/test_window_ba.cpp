@@ -156,6 +156,7 @@ TEST(PointToPlaneCost, JacobiansMatchAutomaticDifferentiation) {
                                        plus);
   };
   double worst = 0;
+  constexpr int kPoints = 3;
   for (int trial = 0; trial < 200; ++trial) {
     Eigen::Quaterniond qa(rotation_from_vector(vec(1.0)));
     Eigen::Quaterniond qb(rotation_from_vector(vec(0.2)) * qa.toRotationMatrix());
@@ -163,40 +164,78 @@ TEST(PointToPlaneCost, JacobiansMatchAutomaticDifferentiation) {
     Eigen::Vector3d ta = vec(5.0), tb = ta + vec(0.2);
     Eigen::Vector4d plane;
     plane << vec(1.0).normalized(), 0.1 * N(rng);
-    const gt::SweepPointToPlaneError e{vec(10.0), trial % 5 == 0 ? 1e-9 : U(rng), vec(10.0), 100.0};
-    const double* params[5] = {qa.coeffs().data(), ta.data(), qb.coeffs().data(), tb.data(),
-                               plane.data()};
-    double r_auto = 0, r_ours = 0;
-    double J_auto[5][4], J_ours[5][4];
-    double* Ja[5] = {J_auto[0], J_auto[1], J_auto[2], J_auto[3], J_auto[4]};
-    double* Jo[5] = {J_ours[0], J_ours[1], J_ours[2], J_ours[3], J_ours[4]};
-    ceres::AutoDiffCostFunction<gt::SweepPointToPlaneError, 1, 4, 3, 4, 3, 4> automatic(
-        new gt::SweepPointToPlaneError(e));
-    ASSERT_TRUE(automatic.Evaluate(params, &r_auto, Ja));
-    ASSERT_TRUE(gt::SweepPointToPlaneCost(e).Evaluate(params, &r_ours, Jo));
-    const double scale = std::abs(r_auto) + 1e3;  // w times the lever of 10 m
-    EXPECT_NEAR(r_ours, r_auto, 1e-9 * scale);
-    for (int b : {0, 2}) {
-      const double d = (tangent(params[b], J_ours[b]) - tangent(params[b], J_auto[b])).norm();
-      worst = std::max(worst, d / scale);
-      EXPECT_LT(d, 1e-7 * scale) << "trial " << trial << " rotation block " << b;
+    Eigen::Matrix<double, 7, 1> knot_a, knot_b;  // the knots' blocks: quaternion, translation
+    knot_a << qa.coeffs(), ta;
+    knot_b << qb.coeffs(), tb;
+    const Eigen::Vector3d c = vec(10.0);
+    std::vector<gt::SweepPlanePointsCost::Point> points;
+    std::vector<Eigen::Vector3d> rigid_points;
+    for (int i = 0; i < kPoints; ++i) {
+      const double f = i == 0 ? 0.0 : (trial % 5 == 0 ? 1e-9 : U(rng));
+      points.push_back({vec(10.0), f});
+      rigid_points.push_back(points.back().p_lidar);
     }
-    for (int b : {1, 3, 4}) {
-      for (int i = 0; i < (b == 4 ? 4 : 3); ++i)
-        EXPECT_NEAR(J_ours[b][i], J_auto[b][i], 1e-9 * scale) << "block " << b << " " << i;
+    const gt::SweepPlanePointsCost sweep(points, c, 100.0);
+    const gt::PlanePointsCost rigid(rigid_points, c, 100.0);
+    double r_ours[kPoints], r_rigid[kPoints], Ja_ours[7 * kPoints], Jb_ours[7 * kPoints],
+        Jp_ours[4 * kPoints], Jra_ours[7 * kPoints], Jrp_ours[4 * kPoints];
+    const double* ours_params[3] = {knot_a.data(), knot_b.data(), plane.data()};
+    double* J_ours[3] = {Ja_ours, Jb_ours, Jp_ours};
+    ASSERT_TRUE(sweep.Evaluate(ours_params, r_ours, J_ours));
+    const double* rigid_params[2] = {knot_a.data(), plane.data()};
+    double* J_rigid[2] = {Jra_ours, Jrp_ours};
+    ASSERT_TRUE(rigid.Evaluate(rigid_params, r_rigid, J_rigid));
+    for (int i = 0; i < kPoints; ++i) {
+      const gt::SweepPointToPlaneError e{points[i].p_lidar, points[i].fraction, c, 100.0};
+      const double* params[5] = {qa.coeffs().data(), ta.data(), qb.coeffs().data(), tb.data(),
+                                 plane.data()};
+      double r_auto = 0, J_auto[5][4];
+      double* Ja[5] = {J_auto[0], J_auto[1], J_auto[2], J_auto[3], J_auto[4]};
+      ceres::AutoDiffCostFunction<gt::SweepPointToPlaneError, 1, 4, 3, 4, 3, 4> automatic(
+          new gt::SweepPointToPlaneError(e));
+      ASSERT_TRUE(automatic.Evaluate(params, &r_auto, Ja));
+      const double scale = std::abs(r_auto) + 1e3;  // w times the lever of 10 m
+      EXPECT_NEAR(r_ours[i], r_auto, 1e-9 * scale);
+      // Each knot's block: the quaternion's 4 (compared in the tangent), the translation's 3.
+      for (int k = 0; k < 2; ++k) {
+        const double* J_knot = (k == 0 ? Ja_ours : Jb_ours) + 7 * i;
+        const double d =
+            (tangent(params[2 * k], J_knot) - tangent(params[2 * k], J_auto[2 * k])).norm();
+        worst = std::max(worst, d / scale);
+        EXPECT_LT(d, 1e-7 * scale) << "trial " << trial << " point " << i << " knot " << k;
+        for (int j = 0; j < 3; ++j)
+          EXPECT_NEAR(J_knot[4 + j], J_auto[2 * k + 1][j], 1e-9 * scale)
+              << "knot " << k << " t" << j;
+      }
+      for (int j = 0; j < 4; ++j) EXPECT_NEAR(Jp_ours[4 * i + j], J_auto[4][j], 1e-9 * scale);
+      // Through Huber's loss at half the residual (or twice it: no change), each point alone:
+      // r'^2 = 2 h |r| - h^2 and r' moves as h / r' times r.
+      for (const double h : {0.5 * std::abs(r_auto), 2.0 * std::abs(r_auto)}) {
+        const gt::SweepPlanePointsCost huber({points[i]}, c, 100.0, h);
+        double rh = 0, Jh[3][7];
+        double* Jhp[3] = {Jh[0], Jh[1], Jh[2]};
+        ASSERT_TRUE(huber.Evaluate(ours_params, &rh, Jhp));
+        const bool outside = std::abs(r_auto) > h;
+        const double expected =
+            outside ? std::copysign(std::sqrt(2 * h * std::abs(r_auto) - h * h), r_auto) : r_auto;
+        EXPECT_NEAR(rh, expected, 1e-9 * scale);
+        const double slope = outside ? h / std::abs(expected) : 1.0;
+        for (int j = 0; j < 3; ++j) EXPECT_NEAR(Jh[0][4 + j], slope * J_auto[1][j], 1e-9 * scale);
+        for (int j = 0; j < 4; ++j) EXPECT_NEAR(Jh[2][j], slope * J_auto[4][j], 1e-9 * scale);
+      }
+      // The rigid term, at knot a.
+      const gt::PointToPlaneError rigid_e{points[i].p_lidar, c, 100.0};
+      const double* rp[3] = {params[0], params[1], params[4]};
+      double* Jra[3] = {J_auto[0], J_auto[1], J_auto[4]};
+      ceres::AutoDiffCostFunction<gt::PointToPlaneError, 1, 4, 3, 4> rigid_automatic(
+          new gt::PointToPlaneError(rigid_e));
+      ASSERT_TRUE(rigid_automatic.Evaluate(rp, &r_auto, Jra));
+      EXPECT_NEAR(r_rigid[i], r_auto, 1e-9 * scale);
+      EXPECT_LT((tangent(params[0], Jra_ours + 7 * i) - tangent(params[0], J_auto[0])).norm(),
+                1e-7 * scale);
+      for (int j = 0; j < 3; ++j) EXPECT_NEAR(Jra_ours[7 * i + 4 + j], J_auto[1][j], 1e-9 * scale);
+      for (int j = 0; j < 4; ++j) EXPECT_NEAR(Jrp_ours[4 * i + j], J_auto[4][j], 1e-9 * scale);
     }
-    // The rigid term, at knot a.
-    const gt::PointToPlaneError rigid{e.p_lidar, e.c_world, e.inv_sigma};
-    const double* rigid_params[3] = {params[0], params[1], params[4]};
-    double* Jra[3] = {J_auto[0], J_auto[1], J_auto[4]};
-    double* Jro[3] = {J_ours[0], J_ours[1], J_ours[4]};
-    ceres::AutoDiffCostFunction<gt::PointToPlaneError, 1, 4, 3, 4> rigid_automatic(
-        new gt::PointToPlaneError(rigid));
-    ASSERT_TRUE(rigid_automatic.Evaluate(rigid_params, &r_auto, Jra));
-    ASSERT_TRUE(gt::PointToPlaneCost(rigid).Evaluate(rigid_params, &r_ours, Jro));
-    EXPECT_NEAR(r_ours, r_auto, 1e-9 * scale);
-    EXPECT_LT((tangent(params[0], J_ours[0]) - tangent(params[0], J_auto[0])).norm(), 1e-7 * scale);
-    for (int i = 0; i < 4; ++i) EXPECT_NEAR(J_ours[4][i], J_auto[4][i], 1e-9 * scale);
   }
   std::printf("[ figures ] the largest tangent Jacobian difference, relative: %.2e\n", worst);
 }
