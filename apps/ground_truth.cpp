@@ -6,6 +6,7 @@
 
 #include "cli.h"
 #include "rigcal/core/error.h"
+#include "rigcal/core/text.h"
 #include "rigcal/gt/step.h"
 #include "rigcal/io/files.h"
 #include "rigcal/io/ground_truth_io.h"
@@ -19,9 +20,11 @@ namespace {
 namespace fs = std::filesystem;
 
 struct Options {
-  std::string recording, rig, out, sigmas, odometry, covariances, gnss, report, scans;
+  std::string recording, rig, out, sigmas, odometry, covariances, gnss, report, scans, map, markers;
+  double map_voxel_m = gt::MapConfig{}.voxel_size_m, marker_intensity = 0;
   std::string gnss_sensor = "gnss", odometry_preset;
-  double max_fix_gap_s = 0.5, fix_correlation_s = 0.0;
+  double max_fix_gap_s = 0.5;
+  std::string fix_correlation = "auto";
   bool no_bundle_adjustment = false;
   size_t window_scans = gt::SequenceBaConfig{}.window_scans;
   size_t window_overlap = gt::SequenceBaConfig{}.overlap_scans;
@@ -43,8 +46,8 @@ void run(const Options& o) {
     in.scans = lidar::scans_folder(o.scans, console_progress());
   } else if (o.odometry.empty()) {
     in.scans = lidar::scans_folder(o.recording, console_progress());
-  } else if (!o.no_bundle_adjustment) {
-    try {  // the scans of the bundle adjustment, when the recording has them
+  } else if (!o.no_bundle_adjustment || !o.map.empty() || !o.markers.empty()) {
+    try {  // the scans of the bundle adjustment and the map, when the recording has them
       in.scans = lidar::scans_folder(o.recording, console_progress());
     } catch (const Error&) {
     }
@@ -54,15 +57,25 @@ void run(const Options& o) {
   options.gnss_sensor = o.gnss_sensor;
   options.odometry_preset = o.odometry_preset;
   options.pose_graph.max_fix_gap_s = o.max_fix_gap_s;
-  options.pose_graph.fix_correlation_s = o.fix_correlation_s;
+  options.pose_graph.fix_correlation_s =
+      o.fix_correlation == "auto" ? -1.0 : parse_double(o.fix_correlation, "--fix-correlation");
   options.bundle_adjustment = !o.no_bundle_adjustment;
   options.ba.window_scans = o.window_scans;
   options.ba.overlap_scans = o.window_overlap;
+  options.map = !o.map.empty();
+  options.map_config.voxel_size_m = o.map_voxel_m;
+  options.map_config.bright_intensity = o.marker_intensity;
+  if (!o.markers.empty()) {
+    in.markers = io::read_marker_survey(o.markers);
+    in.markers_file = o.markers;
+  }
   const std::string sigmas =
       o.sigmas.empty() ? fs::path(o.out).replace_extension("").string() + "_sigmas.txt" : o.sigmas;
   std::vector<io::OutputFile> files = {{o.out, ""}, {sigmas, ""}};
   if (!o.report.empty()) files.push_back({o.report + "/ground_truth.json", ""});
+  if (!o.map.empty()) files.push_back({o.map, ""});
   io::refuse_outputs_over_inputs(files, {{"gnss", in.gnss},
+                                         {"markers", in.markers_file},
                                          {"odometry", in.odometry},
                                          {"covariances", in.covariances},
                                          {"scans", in.scans},
@@ -83,6 +96,8 @@ void run(const Options& o) {
                1e3 * s["prior_residual_horizontal_m"]["rms"].get<double>(),
                1e3 * s["prior_residual_vertical_m"]["rms"].get<double>());
   }
+  fmt::print("the fixes' error correlation time: {:.1f} s ({})\n", run.fix_correlation_s,
+             s["fix_correlation"].get<std::string>());
   if (!s["pose_sigma_horizontal_m"].is_null()) {
     fmt::print("pose sigmas: horizontal median {:.1f} mm (max {:.1f}), yaw median {:.3f} deg\n",
                1e3 * s["pose_sigma_horizontal_m"]["median"].get<double>(),
@@ -100,8 +115,26 @@ void run(const Options& o) {
         1e3 * b["point_plane_rms_after_m"]["median"].get<double>(),
         1e3 * b["pose_change_from_stage1_m"]["rms"].get<double>());
   }
+  if (run.map) {
+    fmt::print("map: {} points in {} m voxels from {} scans\n", run.map->points.size(),
+               run.map->voxel_size_m, run.map->scans);
+  }
+  if (run.markers) {
+    const gt::MarkerCheck& c = *run.markers;
+    fmt::print(
+        "markers: {} of {} found; distances between them against the survey's: rms "
+        "{:.1f} mm, max {:.1f} mm ({} pairs)\n",
+        c.found, in.markers->ids.size(), 1e3 * c.rms_error_m, 1e3 * c.max_error_m, c.pairs.size());
+  }
   for (const nlohmann::json& n : report["notes"]) fmt::print("note: {}\n", n.get<std::string>());
-  if (!o.report.empty()) files[2].content = report.dump(1) + "\n";
+  if (!o.report.empty())
+    files[2].content = report.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+  if (!o.map.empty()) {
+    if (run.map)
+      files.back().content = io::point_cloud_to_ply(run.map->points, run.map->intensity);
+    else
+      files.pop_back();
+  }
   auto say_undetermined = [&g] {
     for (const gt::Undetermined& u : g.undetermined)
       fmt::print(stderr, "undetermined: {}: {}\n", u.what, u.why);
@@ -109,7 +142,7 @@ void run(const Options& o) {
   if (g.T_enu_lidar.empty()) {
     // Nothing placed: the report only.
     say_undetermined();
-    if (!o.report.empty()) io::write_files_atomic({files[2]});
+    if (!o.report.empty()) io::write_files_atomic({files[2]});  // the report only
     throw Exit{3};
   }
   files[0].content = io::ground_truth_to_text(g.T_enu_lidar);
@@ -167,10 +200,11 @@ void add_ground_truth(CLI::App& app) {
                   "apart, s")
       ->check(seconds_within(1e-6, 60))
       ->capture_default_str();
-  cmd->add_option("--fix-correlation", o->fix_correlation_s,
-                  "the fixes' error correlation time, s: priors within it count as one "
-                  "(0: independent)")
-      ->check(seconds_within(0, 600))
+  cmd->add_option("--fix-correlation", o->fix_correlation,
+                  "the fixes' error correlation time, s: priors within it count as one (0: "
+                  "independent; auto: from the residuals of a solve that takes them as "
+                  "independent, then solved again)")
+      ->check(CLI::IsMember({"auto"}) | seconds_within(0, 600))
       ->capture_default_str();
   cmd->add_option("--scans", o->scans,
                   "the scans (a folder, a capture, a recording; default: the recording's)");
@@ -183,6 +217,19 @@ void add_ground_truth(CLI::App& app) {
                   "scans each window shares with the previous one")
       ->check(CLI::Range(size_t(0), size_t(999)))
       ->capture_default_str();
+  cmd->add_option("--map", o->map,
+                  "output map: the scans placed by the ground truth, one point a voxel (binary "
+                  "PLY: x y z intensity, the ENU frame)");
+  cmd->add_option("--map-voxel", o->map_voxel_m, "the map's voxel, m")
+      ->check(CLI::Range(0.01, 10.0))
+      ->capture_default_str();
+  cmd->add_option("--markers", o->markers,
+                  "survey markers to check the map against (CSV: id,x,y,z in any frame, or "
+                  "id_a,id_b,distance in m): found as clusters of bright points, their distances "
+                  "compared with the survey's");
+  cmd->add_option("--marker-intensity", o->marker_intensity,
+                  "the intensity a marker's points reach (default: 10x the first scan's median)")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--report", o->report,
                   "report folder: ground_truth.json, one row a prior, one a window");
   cmd->callback([o] { run(*o); });

@@ -42,7 +42,7 @@ void run(const Options& o) {
   files[1].content = io::step_covariances_to_text(lidar::step_covariances(run));
   const nlohmann::json report = lidar::odometry_report(run);
   if (!o.report.empty()) {
-    files[2].content = report.dump(1) + "\n";
+    files[2].content = report.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
     for (auto& [name, svg] : lidar::odometry_figures(report))
       files.push_back({o.report + "/" + name, std::move(svg)});
   }

@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <memory>
@@ -32,23 +33,31 @@ struct Options {
 void run(const Options& o) {
   const rig::Rig rig = o.rig.empty() ? rig::parse_rig_yaml(kSampleRigYaml, "<bundled sample rig>")
                                      : rig::read_rig_file(o.rig);
-  sim::SimConfig config;
-  if (!o.config.empty()) io::read_sim_config(o.config, config);
-  if (o.seed_given) config.seed = o.seed;
-  if (!o.target.empty()) config.target = io::read_target_file(o.target);
   std::vector<std::string> parts;
   for (size_t start = 0; start <= o.what.size();) {
     const size_t comma = std::min(o.what.find(',', start), o.what.size());
     const std::string part = o.what.substr(start, comma - start);
     if (part != "stereo" && part != "lidar-camera" && part != "imu" && part != "trajectories" &&
-        part != "scans") {
+        part != "scans" && part != "ground-truth") {
       throw Error(fmt::format(
-          "--what: unknown part '{}'; expected stereo, lidar-camera, imu, trajectories, scans",
+          "--what: unknown part '{}'; expected stereo, lidar-camera, imu, trajectories, scans, "
+          "ground-truth",
           part));
     }
     parts.push_back(part);
     start = comma + 1;
   }
+  const auto has = [&](std::string_view p) {
+    return std::find(parts.begin(), parts.end(), p) != parts.end();
+  };
+  if (has("ground-truth") && has("trajectories"))
+    throw Error("--what: ground-truth is the trajectories part with sweeps and markers; give one");
+  // The ground-truth recording is the trajectories part from its own defaults.
+  sim::SimConfig config;
+  if (has("ground-truth")) sim::ground_truth_defaults(config);
+  if (!o.config.empty()) io::read_sim_config(o.config, config);
+  if (o.seed_given) config.seed = o.seed;
+  if (!o.target.empty()) config.target = io::read_target_file(o.target);
   const fs::path out = o.out;
   std::error_code ec;
   if (fs::exists(out, ec) && !fs::is_empty(out, ec)) {
@@ -83,7 +92,7 @@ void run(const Options& o) {
       if (part == "lidar-camera")
         io::write_lidar_camera(tmp, sim::simulate_lidar_camera(rig, config), truth);
       if (part == "imu") io::write_imu(tmp, sim::simulate_imu_part(rig, config), truth);
-      if (part == "trajectories") {
+      if (part == "trajectories" || part == "ground-truth") {
         const sim::TrajectoryPart t =
             sim::simulate_trajectories(rig, config, config.replay_tum.empty() ? nullptr : &replay);
         io::write_trajectories(tmp, t, truth);
@@ -96,6 +105,7 @@ void run(const Options& o) {
                                          std::fflush(stdout);
                                        }
                                      });
+          if (!drive.markers.empty()) io::write_markers(tmp, drive, t.T_enu_world, truth);
         }
       }
       if (part == "scans") io::write_scans(tmp, sim::simulate_scans(rig, config), truth);
@@ -129,6 +139,9 @@ void add_simulate(CLI::App& app) {
       "  trajectories  true LiDAR poses, drifting LiDAR odometry, GNSS/INS with RTK noise\n"
       "                (trajectories.scans: true in --config adds sweeps along the motion)\n"
       "  scans         LiDAR sweeps along a drive through a street of box buildings\n"
+      "  ground-truth  the trajectories part for `rigcal ground-truth`: a 60 s walk with its\n"
+      "                sweeps, 6 survey markers (trajectories/markers.csv), RTK noise correlated\n"
+      "                over 5 s and a 15 s outage (its defaults; --config changes them)\n"
       "The true rig goes to truth.yaml, the rest of the truth to truth.json. The same seed gives\n"
       "byte-identical files.");
   cmd->add_option("--rig", o->rig, "the true rig (default: the bundled VBR-like sample rig)");

@@ -43,7 +43,7 @@ echo "Benchmark report (bench.json, trajectory_top.svg, ate_along.svg) in $out/b
 echo
 echo "== simulated session of the sample rig (truth in $out/sim/truth.yaml and truth.json);"
 echo "   the motion recording: a 30 s walk with the LiDAR's sweeps, for rigcal's own odometry"
-printf "stereo:\n  views: 12\nscans:\n  count: 3\nlidar_camera:\n  pairs: 8\ntrajectories:\n  duration_s: 30\n  motion: walk\n  scans: true\n" > "$out/sim.yaml"
+printf "stereo:\n  views: 12\nscans:\n  count: 3\nlidar_camera:\n  pairs: 8\ntrajectories:\n  duration_s: 30\n  motion: walk\n  scans: true\n  markers: 6\n" > "$out/sim.yaml"
 "$rigcal" simulate --out "$out/sim" --config "$out/sim.yaml"
 
 echo
@@ -56,20 +56,6 @@ echo "   against the truth"
 "$rigcal" bench --gt "$out/sim/trajectories/truth_lidar.tum" \
   --est "$out/session/reports/hand_eye/lidar_odometry.tum" | sed -n '1,7p'
 echo
-echo "== the walk's ground truth (doc/ground-truth.md): that odometry with its step covariances"
-echo "   and the GNSS/INS positions in a pose graph, through the calibrated lever arm; then the"
-echo "   LiDAR bundle adjustment over windows of the walk's sweeps, whose motions go into the"
-echo "   pose graph again (a few minutes on 2 cores: 300 full OS0-128 sweeps). Exit 3 would mean"
-echo "   something the data cannot determine, said on stderr, with the trajectory still written"
-rc=0
-"$rigcal" ground-truth "$out/sim" --rig "$out/session/calib.yaml" \
-  --odometry "$out/session/reports/hand_eye/lidar_odometry.tum" \
-  --gnss "$out/sim/trajectories/gnss_ins.tum" --out "$out/ground_truth/walk_gt.txt" \
-  --report "$out/ground_truth" || rc=$?
-if [ "$rc" -ne 0 ] && [ "$rc" -ne 3 ]; then exit "$rc"; fi
-echo "   against the truth:"
-"$rigcal" bench --gt "$out/sim/trajectories/truth_lidar.tum" --est "$out/ground_truth/walk_gt.txt" |
-  sed -n '1,7p'
 echo
 echo "== the calibration against the truth (data/sample_rig.yaml)"
 "$rigcal" rig show "$out/session/calib.yaml" | sed -n '1,12p'
@@ -84,5 +70,26 @@ echo
 echo "== published with two recorded sequences (VBR layout: <place>/<seq>/vbr_calib.yaml)"
 mkdir -p "$out/vbr/campus/campus_train0" "$out/vbr/campus/campus_train1"
 "$rigcal" publish "$out/session/calib.yaml" "$out/vbr/campus/campus_train0" \
-  "$out/vbr/campus/campus_train1" --formats vbr,kalibr
+  "$out/vbr/campus/campus_train1" --formats vbr,rigcal,kalibr
 echo "The session's calibration: $out/session/calib.yaml (reports in $out/session/reports/)"
+
+echo
+echo "== the walk's ground truth (doc/ground-truth.md), written in its published sequence folder"
+echo "   beside its calibration (rigcal_calib.yaml: it keeps the clock offsets vbr_calib.yaml"
+echo "   drops): that odometry with its step covariances and the GNSS/INS positions in a pose"
+echo "   graph, through the calibrated lever arm; then the LiDAR bundle adjustment over windows"
+echo "   of the walk's sweeps, whose motions go into the pose graph again (about a minute on 2"
+echo "   cores: 300 full OS0-128 sweeps); then the map, and in it the six survey markers the"
+echo "   simulator placed beside the path, their distances against the survey's. Exit 3 would"
+echo "   mean something the data cannot determine, said on stderr, the trajectory still written"
+seq="$out/vbr/campus/campus_train0"
+rc=0
+"$rigcal" ground-truth "$out/sim" --rig "$seq/rigcal_calib.yaml" \
+  --odometry "$out/session/reports/hand_eye/lidar_odometry.tum" \
+  --gnss "$out/sim/trajectories/gnss_ins.tum" --out "$seq/campus_train0_gt.txt" \
+  --markers "$out/sim/trajectories/markers.csv" --map "$out/ground_truth/campus_train0_map.ply" \
+  --report "$out/ground_truth" || rc=$?
+if [ "$rc" -ne 0 ] && [ "$rc" -ne 3 ]; then exit "$rc"; fi
+echo "   scored against the truth:"
+"$rigcal" bench --gt "$out/sim/trajectories/truth_lidar.tum" --est "$seq/campus_train0_gt.txt" |
+  sed -n '1,7p'

@@ -369,11 +369,13 @@ PoseGraphResult solve_pose_graph(const OdometryInput& odometry,
                      "rotation is kept. Move the rig over a few metres in two directions.",
                      config.min_spread_m)});
   }
-  // Priors closer in time than the fixes' correlation share their error: counted once.
+  // Priors closer in time than the fixes' correlation share their error.
   double prior_scale = 1.0;
   if (config.fix_correlation_s > 0 && n >= 2) {
     const double scan_rate = double(n - 1) / (scans.stamps.back() - scans.stamps.front()).seconds();
-    prior_scale = std::max(1.0, config.fix_correlation_s * scan_rate);
+    // A first-order Gauss-Markov error of correlation time tau averages over a span T as
+    // T / (2 tau) independent samples would.
+    prior_scale = std::max(1.0, 2.0 * config.fix_correlation_s * scan_rate);
   }
 
   out.priors.resize(priors.size());
@@ -424,6 +426,37 @@ PoseGraphResult solve_pose_graph(const OdometryInput& odometry,
                             : "no pose covariances: the graph's information is singular");
   }
   return out;
+}
+
+double estimate_fix_correlation(const std::vector<PriorResidual>& priors, double max_s) {
+  std::vector<const PriorResidual*> kept;
+  for (const PriorResidual& p : priors)
+    if (!p.rejected) kept.push_back(&p);
+  if (kept.size() < 20) return 0.0;
+  std::sort(kept.begin(), kept.end(),
+            [](const PriorResidual* a, const PriorResidual* b) { return a->stamp < b->stamp; });
+  // The typical spacing of consecutive priors (their median).
+  std::vector<double> gaps;
+  for (size_t k = 1; k < kept.size(); ++k)
+    gaps.push_back((kept[k]->stamp - kept[k - 1]->stamp).seconds());
+  std::nth_element(gaps.begin(), gaps.begin() + long(gaps.size() / 2), gaps.end());
+  const double dt = gaps[gaps.size() / 2];
+  if (!(dt > 0)) return 0.0;
+  double energy = 0;
+  for (const PriorResidual* p : kept) energy += p->residual_enu.squaredNorm();
+  if (!(energy > 0)) return 0.0;
+  const size_t max_lag = std::min(kept.size() / 2, size_t(std::ceil(max_s / dt)));
+  for (size_t lag = 1; lag <= max_lag; ++lag) {
+    double sum = 0, norm = 0;
+    for (size_t k = 0; k + lag < kept.size(); ++k) {
+      if ((kept[k + lag]->stamp - kept[k]->stamp).seconds() > 1.5 * dt * double(lag)) continue;
+      sum += kept[k]->residual_enu.dot(kept[k + lag]->residual_enu);
+      norm +=
+          0.5 * (kept[k]->residual_enu.squaredNorm() + kept[k + lag]->residual_enu.squaredNorm());
+    }
+    if (norm > 0 && sum / norm < std::exp(-1.0)) return lag == 1 ? 0.0 : dt * double(lag);
+  }
+  return dt * double(max_lag);
 }
 
 }  // namespace rigcal::gt

@@ -22,8 +22,10 @@ struct PoseGraphConfig {
   // Sigmas (horizontal, vertical; m) of a fix whose receiver reports none, by its quality.
   Eigen::Vector2d sigma_rtk_fixed{0.02, 0.03}, sigma_rtk_float{0.3, 0.5}, sigma_single{2.0, 4.0};
   // RTK errors drift over seconds: priors closer than this in time share their error, and each
-  // prior's covariance is multiplied by how many scans fall in this time (at least 1), so that
-  // a second of priors counts as one. 0: the fixes' errors taken as independent.
+  // prior's covariance is multiplied by how many scans fall in twice this time (at least 1):
+  // a first-order Gauss-Markov error averages over a span T as T / (2 tau) independent ones. 0: the
+  // fixes' errors taken as independent. (The ground- truth step reads a negative value as: estimate
+  // it, estimate_fix_correlation.)
   double fix_correlation_s = 0.0;
   // The fixes' spread (m, standard deviation) below which they are taken as a point (a
   // standing rig: no heading, the odometry's rotation held) or a line (the start rotation
@@ -51,6 +53,14 @@ std::vector<PositionFix> position_fixes(const Trajectory& T_enu_gnss,
 // the LiDAR frame. Nothing throws on data that fix too little: the result says what is
 // undetermined (no prior at all: no pose; a standing rig: the rotation held at the odometry's;
 // a rotation sigma above max_rotation_sigma_deg, or none on a line: said, the poses kept).
+// The fixes' error correlation time, s, from the residuals of the priors a solve kept (time
+// order; each prior's residual is its fix's error, less what the solve took up): the first lag
+// at which their autocorrelation falls below 1/e, over pairs of priors that lag apart in scans
+// and time (an outage breaks the series); 0 when under one scan's period or fewer than 20
+// priors. Biased low where the trajectory is free to follow the fixes' drift (a weak
+// odometry, a short sequence): it is read from what the solve left.
+double estimate_fix_correlation(const std::vector<PriorResidual>& priors, double max_s = 120.0);
+
 PoseGraphResult solve_pose_graph(const OdometryInput& odometry,
                                  const std::vector<PositionFix>& fixes,
                                  const Eigen::Vector3d& p_lidar_antenna,

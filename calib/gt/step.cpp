@@ -13,6 +13,7 @@
 #include "rigcal/core/text.h"
 #include "rigcal/core/version.h"
 #include "rigcal/io/trajectory_io.h"
+#include "rigcal/report/json.h"
 
 namespace rigcal::gt {
 namespace fs = std::filesystem;
@@ -24,8 +25,6 @@ Trajectory on_base_clock(Trajectory T_enu_gnss, const rig::Sensor& gnss) {
   for (Time& t : T_enu_gnss.stamps) t = rig::on_base_clock(gnss, t);
   return T_enu_gnss;
 }
-
-nlohmann::json vector_json(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
 }  // namespace
 
@@ -119,8 +118,30 @@ GroundTruthRun run_ground_truth(const StepInputs& in, const StepOptions& o,
   }
   report::tell(progress, "reading the GNSS", 1, 1);
 
+  // The fixes' correlation time, when not given: from the residuals of a solve that takes them
+  // as independent, then solved again with it.
+  auto solve = [&](const OdometryInput& motions) {
+    PoseGraphConfig config = o.pose_graph;
+    if (config.fix_correlation_s >= 0)
+      return solve_pose_graph(motions, run.fixes, run.p_lidar_antenna, config);
+    // A solve that takes the fixes as more independent than they are follows their drift, and
+    // its residuals understate the correlation: estimated again from each solve's residuals
+    // until it settles (within 10 %, at most 6 solves).
+    config.fix_correlation_s = 0;
+    PoseGraphResult g = solve_pose_graph(motions, run.fixes, run.p_lidar_antenna, config);
+    run.fix_correlation_estimated = true;
+    for (int solves = 1; solves < 6; ++solves) {
+      const double tau = estimate_fix_correlation(g.priors);
+      if (std::abs(tau - config.fix_correlation_s) <= 0.1 * tau) break;
+      config.fix_correlation_s = tau;
+      g = solve_pose_graph(motions, run.fixes, run.p_lidar_antenna, config);
+    }
+    run.fix_correlation_s = config.fix_correlation_s;
+    return g;
+  };
+  run.fix_correlation_s = o.pose_graph.fix_correlation_s;
   report::tell(progress, "solving the pose graph", 0, 1);
-  run.graph = solve_pose_graph(odometry, run.fixes, run.p_lidar_antenna, o.pose_graph);
+  run.graph = solve(odometry);
   report::tell(progress, "solving the pose graph", 1, 1);
 
   // Stage 2: the windows start from the graph's poses; their motions, in a graph again.
@@ -148,8 +169,28 @@ GroundTruthRun run_ground_truth(const StepInputs& in, const StepOptions& o,
     }
     report::tell(progress, "solving the pose graph of the adjusted motions", 0, 1);
     run.stage1 = std::move(run.graph);
-    run.graph = solve_pose_graph(run.ba->motions, run.fixes, run.p_lidar_antenna, o.pose_graph);
+    run.graph = solve(run.ba->motions);
     report::tell(progress, "solving the pose graph of the adjusted motions", 1, 1);
+  }
+  // The map, placed by the result, and the markers in it.
+  if ((o.map || in.markers) && in.scans.empty()) {
+    run.notes.push_back("no scans: no map, and no markers' check");
+  } else if ((o.map || in.markers) && run.graph.T_enu_lidar.size() < 2) {
+    run.notes.push_back("the pose graph placed no poses: no map, and no markers' check");
+  } else if (o.map || in.markers) {
+    lidar::ScanStream stream(in.scans);
+    run.map =
+        build_map([&] { return stream.next(); }, run.graph.T_enu_lidar, o.map_config, progress);
+    if (in.markers) {
+      run.markers =
+          check_markers(bright_clusters(run.map->bright, o.markers), *in.markers, o.markers);
+      if (run.markers->found < in.markers->ids.size()) {
+        run.notes.push_back(fmt::format(
+            "markers: {} of the survey's {} found in the map (bright points at intensity {:.4g} "
+            "or above: --marker-intensity)",
+            run.markers->found, in.markers->ids.size(), run.map->bright_intensity));
+      }
+    }
   }
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return run;
@@ -169,7 +210,7 @@ nlohmann::json ground_truth_report(const GroundTruthRun& run, const StepInputs& 
                                              {"longitude_deg", run.origin->longitude_deg},
                                              {"height_m", run.origin->height_m}}}}
                           : nlohmann::json{{"enu", "the GNSS/INS poses' frame"}};
-  j["lever_arm_m"] = vector_json(run.p_lidar_antenna);
+  j["lever_arm_m"] = report::vector_json(run.p_lidar_antenna);
   // Residuals of the priors kept, horizontal and vertical; the poses' sigmas.
   std::vector<double> horizontal, vertical, sigma_h, sigma_v, sigma_yaw;
   for (const PriorResidual& p : g.priors) {
@@ -200,22 +241,26 @@ nlohmann::json ground_truth_report(const GroundTruthRun& run, const StepInputs& 
       size_t(std::count_if(run.fixes.begin(), run.fixes.end(), [](const PositionFix& f) {
         return f.quality == FixQuality::rtk_fixed;
       }));
-  j["summary"] = {{"poses", g.T_enu_lidar.size()},
-                  {"path_length_m", g.T_enu_lidar.empty() ? 0.0 : path_length(g.T_enu_lidar)},
-                  {"fixes", run.fixes.size()},
-                  {"fixes_rtk_fixed", fixed},
-                  {"fixes_unused", g.fixes_unused},
-                  {"priors", g.priors.size()},
-                  {"priors_rejected", g.rejected},
-                  {"outages", outages},
-                  {"undetermined", undetermined},
-                  {"prior_residual_horizontal_m", stats(horizontal)},
-                  {"prior_residual_vertical_m", stats(vertical)},
-                  {"pose_sigma_horizontal_m", stats(sigma_h)},
-                  {"pose_sigma_vertical_m", stats(sigma_v)},
-                  {"pose_sigma_yaw_deg", stats(sigma_yaw)},
-                  {"solver_iterations", g.iterations},
-                  {"seconds", run.seconds}};
+  j["summary"] = {
+      {"poses", g.T_enu_lidar.size()},
+      {"path_length_m", g.T_enu_lidar.empty() ? 0.0 : path_length(g.T_enu_lidar)},
+      {"fixes", run.fixes.size()},
+      {"fixes_rtk_fixed", fixed},
+      {"fixes_unused", g.fixes_unused},
+      {"priors", g.priors.size()},
+      {"priors_rejected", g.rejected},
+      {"outages", outages},
+      {"undetermined", undetermined},
+      {"prior_residual_horizontal_m", stats(horizontal)},
+      {"prior_residual_vertical_m", stats(vertical)},
+      {"pose_sigma_horizontal_m", stats(sigma_h)},
+      {"pose_sigma_vertical_m", stats(sigma_v)},
+      {"pose_sigma_yaw_deg", stats(sigma_yaw)},
+      {"fix_correlation_s", run.fix_correlation_s},
+      {"fix_correlation",
+       run.fix_correlation_estimated ? "estimated from the solves' prior residuals" : "given"},
+      {"solver_iterations", g.iterations},
+      {"seconds", run.seconds}};
   if (run.ba) {
     const SequenceBaResult& ba = *run.ba;
     std::vector<double> before, after;
@@ -257,6 +302,54 @@ nlohmann::json ground_truth_report(const GroundTruthRun& run, const StepInputs& 
                               {"seconds", ba.seconds},
                               {"per_window", std::move(windows)}};
   }
+  if (run.map) {
+    const LidarMap& m = *run.map;
+    j["map"] = {{"voxel_size_m", m.voxel_size_m},
+                {"points", m.points.size()},
+                {"scans", m.scans},
+                {"scan_points", m.scan_points},
+                {"scans_unused", m.scans_unused},
+                {"bright_intensity", m.bright_intensity},
+                {"bright_points", m.bright.size()}};
+  }
+  if (run.markers) {
+    const MarkerCheck& c = *run.markers;
+    const MarkerSurvey& survey = *in.markers;
+    nlohmann::json markers = nlohmann::json::array(), pairs = nlohmann::json::array(),
+                   clusters = nlohmann::json::array();
+    for (size_t i = 0; i < survey.ids.size(); ++i) {
+      nlohmann::json row = {{"id", survey.ids[i]}, {"found", c.cluster_of[i] >= 0}};
+      if (c.cluster_of[i] >= 0) {
+        const BrightCluster& b = c.clusters[size_t(c.cluster_of[i])];
+        row["centre_m"] = report::vector_json(b.centre);
+        row["points"] = b.points;
+        row["sigma_m"] = b.sigma_m;
+      }
+      markers.push_back(row);
+    }
+    for (const MarkerDistanceCheck& p : c.pairs) {
+      pairs.push_back({{"a", survey.ids[p.a]},
+                       {"b", survey.ids[p.b]},
+                       {"measured_m", p.measured_m},
+                       {"estimated_m", p.estimated_m},
+                       {"error_m", p.estimated_m - p.measured_m},
+                       {"sigma_m", p.sigma_m}});
+    }
+    for (const BrightCluster& b : c.clusters) {
+      clusters.push_back({{"centre_m", report::vector_json(b.centre)},
+                          {"points", b.points},
+                          {"extent_m", b.extent_m}});
+    }
+    j["markers"] = {{"survey", in.markers_file.string()},
+                    {"markers", survey.ids.size()},
+                    {"found", c.found},
+                    {"distance_error_rms_m", c.rms_error_m},
+                    {"distance_error_max_m", c.max_error_m},
+                    {"tolerance_m", c.tolerance_m},
+                    {"per_marker", std::move(markers)},
+                    {"pairs", std::move(pairs)},
+                    {"bright_clusters", std::move(clusters)}};
+  }
   j["notes"] = run.notes;
   for (const std::string& n : g.notes) j["notes"].push_back(n);
   nlohmann::json priors = nlohmann::json::array();
@@ -264,7 +357,7 @@ nlohmann::json ground_truth_report(const GroundTruthRun& run, const StepInputs& 
     priors.push_back({{"stamp_s", to_seconds_text(p.stamp)},
                       {"pose", p.node},
                       {"fix", p.fix},
-                      {"residual_enu_m", vector_json(p.residual_enu)},
+                      {"residual_enu_m", report::vector_json(p.residual_enu)},
                       {"mahalanobis2", p.mahalanobis2},
                       {"rejected", p.rejected}});
   }

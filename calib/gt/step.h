@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "rigcal/gt/map.h"
+#include "rigcal/gt/markers.h"
 #include "rigcal/gt/pose_graph.h"
 #include "rigcal/gt/sequence_ba.h"
 #include "rigcal/io/gnss_fixes.h"
@@ -29,6 +31,11 @@ struct StepOptions {
   // Stage 2 on StepInputs::scans (skipped, with a note, when there are none).
   bool bundle_adjustment = true;
   SequenceBaConfig ba;
+  // The map of the scans placed by the result (map.h): built when asked, or when a markers'
+  // survey is given.
+  bool map = false;
+  MapConfig map_config;
+  MarkerConfig markers;
 };
 
 struct StepInputs {
@@ -43,6 +50,9 @@ struct StepInputs {
   std::filesystem::path gnss;
   rig::Rig rig;  // the lever arm (the GNSS sensor's T_b) and its clock (time_offset)
   std::string rig_source;
+  // Survey markers to check the map against (markers.h; io::read_marker_survey), and their file.
+  std::optional<MarkerSurvey> markers;
+  std::filesystem::path markers_file;
 };
 
 struct GroundTruthRun {
@@ -54,7 +64,13 @@ struct GroundTruthRun {
   Eigen::Vector3d p_lidar_antenna = Eigen::Vector3d::Zero();
   std::optional<io::GeodeticOrigin> origin;    // of the ENU frame, when the GNSS gave fixes
   std::optional<lidar::OdometryRun> odometry;  // when rigcal's ran here
+  std::optional<LidarMap> map;                 // when asked, from the scans
+  std::optional<MarkerCheck> markers;          // when a survey was given
   std::string odometry_preset;
+  // The fixes' error correlation time the last solve used, s: the configuration's, or
+  // estimated (PoseGraphConfig::fix_correlation_s < 0 asks for that).
+  double fix_correlation_s = 0;
+  bool fix_correlation_estimated = false;
   std::vector<std::string> notes;
   double seconds = 0;
 };

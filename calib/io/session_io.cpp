@@ -62,9 +62,10 @@ std::string simulated_session_yaml(const std::vector<std::string>& parts, bool t
       "target: target.yaml\n";
   if (has("stereo")) out += "cameras: stereo\n";
   if (has("lidar-camera")) out += "lidar_camera: lidar_camera\n";
-  trajectory_scans = trajectory_scans && has("trajectories");
+  const bool trajectories = has("trajectories") || has("ground-truth");
+  trajectory_scans = trajectory_scans && trajectories;
   if (has("imu") || trajectory_scans) out += "motion: .\n";
-  if (has("trajectories")) {
+  if (trajectories) {
     out += trajectory_scans
                ? "# No odometry named: rigcal's own runs on the motion's sweeps (ouster_points/).\n"
                : "# A simulated LiDAR odometry (no sweeps were simulated along the motion).\n"
@@ -199,6 +200,25 @@ void write_trajectory_scans(const fs::path& dir, sim::SweepDrive& drive, size_t 
       {"folder", "ouster_points"},
       {"count", count},
       {"poses", "trajectories/truth_lidar.tum: sweep k starts at pose k"}};
+}
+
+void write_markers(const fs::path& dir, const sim::SweepDrive& drive, const SE3& T_enu_world,
+                   nlohmann::json& truth) {
+  std::string csv =
+      "# Survey markers (rigcal simulate): id, then the centre of the retro-reflective square in\n"
+      "# the survey's frame (the simulated world's, m); ground truth's --markers reads this file.\n"
+      "id,x,y,z\n";
+  nlohmann::json markers = nlohmann::json::array();
+  for (size_t i = 0; i < drive.markers.size(); ++i) {
+    const Eigen::Vector3d& p = drive.markers[i];
+    const std::string id = fmt::format("M{}", i + 1);
+    csv += fmt::format("{},{:.4f},{:.4f},{:.4f}\n", id, p.x(), p.y(), p.z());
+    markers.push_back({{"id", id},
+                       {"centre_world_m", report::vector_json(p)},
+                       {"centre_enu_m", report::vector_json(T_enu_world * p)}});
+  }
+  write_file_atomic(dir / "trajectories" / "markers.csv", csv);
+  truth["trajectories"]["markers"] = std::move(markers);
 }
 
 void write_scans(const fs::path& dir, const sim::ScanPart& part, nlohmann::json& truth) {

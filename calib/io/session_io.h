@@ -31,6 +31,11 @@ void write_scans(const std::filesystem::path& dir, const sim::ScanPart& part,
 void write_trajectory_scans(const std::filesystem::path& dir, sim::SweepDrive& drive, size_t count,
                             nlohmann::json& truth,
                             const std::function<void(size_t done, size_t total)>& progress = {});
+// The drive's survey markers (sim::SimConfig::markers): trajectories/markers.csv as a total
+// station gives them (`id,x,y,z`, m, in the world frame: the station's own, not the ENU frame of
+// the GNSS) and, in truth.json, their centres in both frames (T_enu_world of the part).
+void write_markers(const std::filesystem::path& dir, const sim::SweepDrive& drive,
+                   const SE3& T_enu_world, nlohmann::json& truth);
 
 // session.yaml of a simulated session (doc/session.md) with the parts written ("stereo",
 // "lidar-camera", "imu", "trajectories", "scans"): the recordings of each step, target.yaml, and

@@ -40,7 +40,7 @@ void apply_sim_config(std::string_view text, std::string_view file, sim::SimConf
       v = x;
     });
   };
-  int columns = 0;  // lidar.columns, applied after lidar.model
+  int columns = 0, beams = 0;  // lidar.columns and lidar.beams, applied after lidar.model
   auto integer = [&](int& v, int low, int high) {
     return Setter([&v, low, high, in_range](const YAML::Node& n) {
       const double x = n.as<double>();
@@ -119,6 +119,7 @@ void apply_sim_config(std::string_view text, std::string_view file, sim::SimConf
        })},
       {"lidar.range_noise_m", num(c.lidar.range_noise_m, 0, 10)},
       {"lidar.columns", integer(columns, 64, 4096)},
+      {"lidar.beams", integer(beams, 8, 256)},
       {"lidar_camera.pairs", integer(c.lidar_camera_pairs, 1, 200)},
       {"lidar_camera.camera",
        Setter([&](const YAML::Node& n) { c.lidar_camera_camera = n.as<std::string>(); })},
@@ -128,6 +129,8 @@ void apply_sim_config(std::string_view text, std::string_view file, sim::SimConf
       {"trajectories.duration_s", num(c.trajectory_duration_s, 1, 36000)},
       {"trajectories.motion", motion(c.trajectory_motion)},
       {"trajectories.scans", flag(c.trajectory_scans)},
+      {"trajectories.markers", integer(c.markers, 0, 24)},
+      {"trajectories.marker_side_m", num(c.marker_side_m, 0.02, 2)},
       {"trajectories.replay",
        Setter([&](const YAML::Node& n) { c.replay_tum = (base / n.as<std::string>()).string(); })},
       {"trajectories.odometry.trans_sigma_m", num(c.odometry.trans_sigma_m, 0, 10)},
@@ -169,6 +172,7 @@ void apply_sim_config(std::string_view text, std::string_view file, sim::SimConf
   };
   walk(root, "");
   if (columns > 0) c.lidar.columns = columns;  // whichever of lidar.model and it comes first
+  if (beams > 0) c.lidar.beams = beams;
 }
 
 void read_sim_config(const std::filesystem::path& path, sim::SimConfig& config) {

@@ -194,7 +194,8 @@ std::vector<LidarPoint> sweep(const Scene& scene, const LidarModel& m,
         albedo = 0.1 + 0.9 * hit->pattern->albedo(hit->board_origin_uv.x() + q.dot(hit->u),
                                                   hit->board_origin_uv.y() + q.dot(hit->v));
       }
-      p.intensity = static_cast<float>(1000.0 * hit->reflectivity * albedo * std::abs(n.dot(d)));
+      const double incidence = hit->retroreflective ? 1.0 : std::abs(n.dot(d));
+      p.intensity = static_cast<float>(1000.0 * hit->reflectivity * albedo * incidence);
       columns[c].push_back(p);
     }
   });

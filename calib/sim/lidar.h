@@ -21,6 +21,9 @@ struct Rect {
   const camera::Pattern* pattern = nullptr;
   Eigen::Vector2d board_origin_uv = Eigen::Vector2d::Zero();  // board point at the centre
   int id = 0;  // which object (0 background; the board's faces > 0)
+  // A retro-reflective sheet (a survey marker): it returns 1000 * reflectivity whatever the
+  // incidence, where a diffuse surface returns that times the cosine of the incidence.
+  bool retroreflective = false;
 };
 
 struct Scene {

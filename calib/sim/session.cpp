@@ -289,6 +289,59 @@ SweepDrive trajectory_drive(const rig::Rig& rig, const SimConfig& cfg, const Tra
   T_ground.t << 0.5 * (lo + hi), z_ground - 0.05;
   const Eigen::Vector2d half = 0.5 * (hi - lo) + Eigen::Vector2d::Constant(cfg.lidar.max_range_m);
   add_box(drive.scene, T_ground, Eigen::Vector3d(half.x(), half.y(), 0.05), 0.2);
+  // The survey markers, as a total station's targets around one place (a hexahedron, in the
+  // VBR paper): over the 24 m of path around its middle (all of it, if shorter), a post 3 m
+  // beside the path (the other side, or 5 m, where the path comes back nearer) at even
+  // intervals, alternately left and right, each with a retro-reflective square facing the path
+  // at 0.8, 1.5 or 2.2 m above the ground in turn.
+  const int markers = std::max(cfg.markers, 0);
+  std::vector<Eigen::Vector2d> posts;
+  const std::vector<SE3>& poses = part.truth_base.T_world_body;
+  std::vector<double> along_path = {0.0};
+  for (size_t k = 1; k < poses.size(); ++k)
+    along_path.push_back(along_path.back() + (poses[k].t - poses[k - 1].t).norm());
+  const double section = std::min(24.0, along_path.back());
+  const double section_start = 0.5 * (along_path.back() - section);
+  for (int i = 0; i < markers; ++i) {
+    const double at_length = section_start + (i + 0.5) / markers * section;
+    const size_t k = std::min<size_t>(
+        poses.size() - 1,
+        size_t(std::lower_bound(along_path.begin(), along_path.end(), at_length) -
+               along_path.begin()));
+    const size_t a = k >= 10 ? k - 10 : 0, b = std::min(k + 10, poses.size() - 1);
+    Eigen::Vector2d along = (poses[b].t - poses[a].t).head<2>();
+    if (along.norm() < 1e-6) along = poses[k].R.col(0).head<2>();
+    along.normalize();
+    const Eigen::Vector2d left(-along.y(), along.x()), at = poses[k].t.head<2>();
+    Eigen::Vector2d post;
+    for (double side : {3.0, -3.0, 5.0, -5.0}) {
+      post = at + side * (i % 2 == 0 ? left : Eigen::Vector2d(-left));
+      if (distance_to_path(post, kReach) > std::abs(side) - 0.5) break;
+    }
+    posts.push_back(post);
+    const Eigen::Vector2d facing = (at - post).normalized();
+    SE3 T_post;
+    T_post.R.col(0) << facing, 0;
+    T_post.R.col(1) << -facing.y(), facing.x(), 0;
+    T_post.R.col(2) = Eigen::Vector3d::UnitZ();
+    T_post.t << post, z_ground + 1.25;
+    add_box(drive.scene, T_post, Eigen::Vector3d(0.15, 0.15, 1.25), 0.4);
+    Rect marker;
+    marker.centre << post + (0.15 + 0.002) * facing, z_ground + 0.8 + 0.7 * (i % 3);
+    marker.u = T_post.R.col(1);
+    marker.v = Eigen::Vector3d::UnitZ();
+    marker.half_u = marker.half_v = 0.5 * cfg.marker_side_m;
+    marker.reflectivity = 5.0;
+    marker.retroreflective = true;
+    marker.id = 100 + i;
+    drive.scene.rects.push_back(marker);
+    drive.markers.push_back(marker.centre);
+  }
+  auto near_a_post = [&](const Eigen::Vector2d& q, double reach) {
+    for (const Eigen::Vector2d& p : posts)
+      if ((p - q).norm() < reach + 1.5) return true;
+    return false;
+  };
   // A box (sometimes also a pole) in most cells of the grid within kReach of the path, never
   // nearer than kClearance to it.
   std::set<std::pair<int, int>> cells;
@@ -305,13 +358,14 @@ SweepDrive trajectory_drive(const rig::Rig& rig, const SimConfig& cfg, const Tra
     const double reflectivity = 0.2 + 0.5 * U(rng);
     const bool box = U(rng) < 0.55, pole = U(rng) < 0.25;
     const Eigen::Vector2d pole_at((i + U(rng)) * kCell, (j + U(rng)) * kCell);
-    if (box && distance_to_path(centre, kReach) > h.head<2>().norm() + kClearance) {
+    if (box && distance_to_path(centre, kReach) > h.head<2>().norm() + kClearance &&
+        !near_a_post(centre, h.head<2>().norm())) {
       SE3 T_box;
       T_box.R = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
       T_box.t << centre, z_ground + h.z();
       add_box(drive.scene, T_box, h, reflectivity);
     }
-    if (pole && distance_to_path(pole_at, kReach) > kClearance) {
+    if (pole && distance_to_path(pole_at, kReach) > kClearance && !near_a_post(pole_at, 0.1)) {
       SE3 T_pole;
       T_pole.t << pole_at, z_ground + 2.0;
       add_box(drive.scene, T_pole, Eigen::Vector3d(0.08, 0.08, 2.0), 0.6);
@@ -333,6 +387,20 @@ Sweep next_sweep(SweepDrive& drive) {
   const double t0 = drive.first_s + drive.next++ / drive.lidar.rate_hz;
   return {Time::from_seconds(drive.base_start_s + t0), drive.T_world_lidar(t0),
           sweep(drive.scene, drive.lidar, drive.T_world_lidar, t0, drive.rng)};
+}
+
+void ground_truth_defaults(SimConfig& c) {
+  c.trajectory_duration_s = 60.0;
+  c.trajectory_motion = MotionKind::walk;
+  c.trajectory_scans = true;
+  c.markers = 6;
+  c.lidar = os0_128();
+  c.lidar.beams = 64;
+  c.lidar.columns = 1024;
+  c.gnss.horizontal_sigma_m = 0.01;
+  c.gnss.vertical_sigma_m = 0.02;
+  c.gnss.correlation_time_s = 5.0;
+  c.gnss.outages = {{20.0, 35.0}};
 }
 
 ScanPart simulate_scans(const rig::Rig& rig, const SimConfig& cfg) {

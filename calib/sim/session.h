@@ -51,6 +51,12 @@ struct SimConfig {
   // ouster_points/), in a courtyard of boxes around the path: rigcal's own odometry can then run
   // on them instead of the simulated lidar_odometry.tum.
   bool trajectory_scans = false;
+  // Survey markers in that courtyard (with trajectory_scans): retro-reflective squares on posts
+  // on both sides of the 24 m of path around its middle, at three heights, as a total station's
+  // targets for checking the ground truth's map. -1: none, or 6 for `rigcal simulate --what
+  // ground-truth`.
+  int markers = -1;
+  double marker_side_m = 0.2;
   // scans along a trajectory in a street world
   int scans = 10;
 };
@@ -107,7 +113,8 @@ struct SweepDrive {
   double base_start_s = 0;
   double first_s = 1.0;  // motion time of the first sweep's start
   std::mt19937_64 rng;
-  int next = 0;  // the next sweep's index
+  int next = 0;                          // the next sweep's index
+  std::vector<Eigen::Vector3d> markers;  // the survey markers' centres in the world frame
 };
 // The street drive of simulate_scans: ground, box buildings, poles and parked cars along a car's
 // path.
@@ -115,7 +122,8 @@ SweepDrive street_drive(const rig::Rig& rig, const SimConfig& config);
 // Sweeps along the trajectories part's path, sweep k starting at its pose k (the same stamps):
 // a courtyard of boxes of many sizes (kiosks, walls, buildings, poles) on a ground plane around
 // the path, none nearer than 2 m to it, drawn from the part's own random stream
-// ("trajectory-scans").
+// ("trajectory-scans"); config.markers survey markers (SimConfig), with no box or pole within
+// 1.5 m of their posts (the courtyard is otherwise the same as without them).
 SweepDrive trajectory_drive(const rig::Rig& rig, const SimConfig& config,
                             const TrajectoryPart& part);
 struct Sweep {
@@ -126,6 +134,12 @@ struct Sweep {
 // The next sweep of the drive (street_drive: config.scans of them fit the world built; later
 // ones leave it).
 Sweep next_sweep(SweepDrive& drive);
+
+// What `rigcal simulate --what ground-truth` starts from (a config file then changes it): a
+// 60 s walk with the LiDAR's sweeps (64 beams over 90 deg, 1024 columns: a quarter of an
+// OS0-128's points, a few hundred MB), 6 survey markers, RTK noise of 1 cm horizontal and 2 cm
+// vertical correlated over 5 s, and a 15 s outage.
+void ground_truth_defaults(SimConfig& config);
 
 StereoPart simulate_stereo(const rig::Rig& rig, const SimConfig& config);
 LidarCameraPart simulate_lidar_camera(const rig::Rig& rig, const SimConfig& config);

@@ -67,6 +67,10 @@ seed("gnss_fixes", "fixes.csv", "time,lat,lon,height,roll,pitch,yaw,std_east,std
 seed("gnss_fixes", "iso_stamps.csv", "timestamp,latitude,longitude,altitude,roll,pitch,heading\n"
      "2024-03-20T10:00:00.000Z,41.9,12.5,40,0,0,90\n2024-03-20T10:00:00.100Z,41.9000001,12.5,40,0,0,91\n")
 
+seed("marker_survey", "positions.csv", "# a total station\nid,x,y,z\nM1,7.5692,-2.1187,-0.9299\n"
+     "M2 15.4002 -4.4094 -0.2299\nM3,26.7303,-4.1680,0.4701\n")
+seed("marker_survey", "distances.csv", "a,b,distance\nM1,M2,8.1891\nM2,M3,11.3543\nM1,M3,19.3212\n")
+
 pts = [(1.0 + 0.1 * k, -2.0 + 0.05 * k, 0.5, 10.0 * k) for k in range(6)] + [(0.0, 0.0, 0.0, 0.0)]
 hdr = ("# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z intensity\n"
        "SIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\nWIDTH %d\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\n"
