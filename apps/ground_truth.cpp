@@ -173,8 +173,10 @@ void add_ground_truth(CLI::App& app) {
       "pose's sigmas. Then, when the scans are there, the geometric LiDAR bundle adjustment:\n"
       "overlapping windows of scans, each sweep deskewed by the motion it estimates, the\n"
       "points brought onto planar patches; the windows' motions replace the odometry's in the\n"
-      "pose graph, solved again with the same priors. Exit 3 when the fixes leave something\n"
-      "undetermined (said on stderr). The photometric term is not built.");
+      "pose graph, solved again with the same priors. With --map or --markers, the scans\n"
+      "placed by the result: the map, and the survey markers found in it as clusters of\n"
+      "bright points, their distances against the survey's. Exit 3 when the fixes leave\n"
+      "something undetermined (said on stderr). The photometric term is not built.");
   cmd->add_option("recording", o->recording,
                   "the recording: its gnss/ (poses.tum, fixes.csv or navsat.csv) and its scans "
                   "(ouster_points/, a capture, a session): the odometry's without --odometry, "
@@ -201,9 +203,9 @@ void add_ground_truth(CLI::App& app) {
       ->check(seconds_within(1e-6, 60))
       ->capture_default_str();
   cmd->add_option("--fix-correlation", o->fix_correlation,
-                  "the fixes' error correlation time, s: priors within it count as one (0: "
-                  "independent; auto: from the residuals of a solve that takes them as "
-                  "independent, then solved again)")
+                  "the fixes' error correlation time, s: each prior weighs as 1 / (2 S x scan "
+                  "rate) of an independent one (0: independent; auto: estimated from the "
+                  "residuals of the solves, each solved again with it until it settles)")
       ->check(CLI::IsMember({"auto"}) | seconds_within(0, 600))
       ->capture_default_str();
   cmd->add_option("--scans", o->scans,
