@@ -3,7 +3,8 @@
 # and exported; a trajectory scored; then a simulated session calibrated in one command
 # (`rigcal calibrate`, hand-eye on rigcal's own LiDAR odometry of the simulated walk) and
 # published with two sequences (`rigcal publish`); the walk's ground truth from that odometry and
-# the GNSS/INS (`rigcal ground-truth`).
+# the GNSS/INS into its sequence folder, with its map and the check of the simulated survey
+# markers in it (`rigcal ground-truth`), scored against the truth (`rigcal bench`).
 set -euo pipefail
 build=${1:-build}
 root=$(cd "$(dirname "$0")/.." && pwd)
