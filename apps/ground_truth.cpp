@@ -30,18 +30,11 @@ struct Options {
   size_t window_overlap = gt::SequenceBaConfig{}.overlap_scans;
 };
 
-fs::path default_gnss(const fs::path& recording) {
-  for (const char* name : {"gnss/poses.tum", "gnss/fixes.csv", "gnss/navsat.csv"})
-    if (fs::exists(recording / name)) return recording / name;
-  throw Error(fmt::format("{}: no gnss/poses.tum, gnss/fixes.csv or gnss/navsat.csv; give --gnss",
-                          recording.string()));
-}
-
 void run(const Options& o) {
   gt::StepInputs in;
   in.rig = rig::read_rig_file(o.rig);
   in.rig_source = o.rig;
-  in.gnss = o.gnss.empty() ? default_gnss(o.recording) : fs::path(o.gnss);
+  in.gnss = o.gnss.empty() ? gt::default_gnss(o.recording) : fs::path(o.gnss);
   if (!o.scans.empty()) {
     in.scans = lidar::scans_folder(o.scans, console_progress());
   } else if (o.odometry.empty()) {
@@ -84,49 +77,7 @@ void run(const Options& o) {
   const gt::GroundTruthRun run = gt::run_ground_truth(in, options, console_progress());
   const gt::PoseGraphResult& g = run.graph;
   const nlohmann::json report = gt::ground_truth_report(run, in);
-  const nlohmann::json& s = report["summary"];
-  fmt::print("poses: {}, path {:.1f} m; fixes: {} ({} RTK fixed), priors {} ({} rejected)\n",
-             s["poses"].get<size_t>(), s["path_length_m"].get<double>(), s["fixes"].get<size_t>(),
-             s["fixes_rtk_fixed"].get<size_t>(), s["priors"].get<size_t>(),
-             s["priors_rejected"].get<size_t>());
-  for (const auto& [from, to] : g.outages)
-    fmt::print("outage: {:.1f} s without a fix, bridged by the odometry\n", (to - from).seconds());
-  if (!s["prior_residual_horizontal_m"].is_null()) {
-    fmt::print("prior residuals: horizontal rms {:.1f} mm, vertical rms {:.1f} mm\n",
-               1e3 * s["prior_residual_horizontal_m"]["rms"].get<double>(),
-               1e3 * s["prior_residual_vertical_m"]["rms"].get<double>());
-  }
-  fmt::print("the fixes' error correlation time: {:.1f} s ({})\n", run.fix_correlation_s,
-             s["fix_correlation"].get<std::string>());
-  if (!s["pose_sigma_horizontal_m"].is_null()) {
-    fmt::print("pose sigmas: horizontal median {:.1f} mm (max {:.1f}), yaw median {:.3f} deg\n",
-               1e3 * s["pose_sigma_horizontal_m"]["median"].get<double>(),
-               1e3 * s["pose_sigma_horizontal_m"]["max"].get<double>(),
-               s["pose_sigma_yaw_deg"]["median"].get<double>());
-  }
-  if (run.ba) {
-    const nlohmann::json& b = report["bundle_adjustment"];
-    fmt::print(
-        "bundle adjustment: {} windows in {:.1f} s; points off their planes rms {:.1f} mm before, "
-        "{:.1f} mm after (median over the windows); poses moved {:.1f} mm rms from the pose "
-        "graph's\n",
-        run.ba->windows.size(), run.ba->seconds,
-        1e3 * b["point_plane_rms_before_m"]["median"].get<double>(),
-        1e3 * b["point_plane_rms_after_m"]["median"].get<double>(),
-        1e3 * b["pose_change_from_stage1_m"]["rms"].get<double>());
-  }
-  if (run.map) {
-    fmt::print("map: {} points in {} m voxels from {} scans\n", run.map->points.size(),
-               run.map->voxel_size_m, run.map->scans);
-  }
-  if (run.markers) {
-    const gt::MarkerCheck& c = *run.markers;
-    fmt::print(
-        "markers: {} of {} found; distances between them against the survey's: rms "
-        "{:.1f} mm, max {:.1f} mm ({} pairs)\n",
-        c.found, in.markers->ids.size(), 1e3 * c.rms_error_m, 1e3 * c.max_error_m, c.pairs.size());
-  }
-  for (const nlohmann::json& n : report["notes"]) fmt::print("note: {}\n", n.get<std::string>());
+  fmt::print("{}", gt::ground_truth_summary(run, report));
   if (!o.report.empty())
     files[2].content = report.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
   if (!o.map.empty()) {

@@ -3,19 +3,15 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <chrono>
 #include <filesystem>
 #include <memory>
 
 #include "cli.h"
 #include "rigcal/core/error.h"
-#include "rigcal/core/version.h"
 #include "rigcal/io/files.h"
 #include "rigcal/io/session_io.h"
 #include "rigcal/io/sim_config.h"
 #include "rigcal/io/target_yaml.h"
-#include "rigcal/io/trajectory_io.h"
-#include "rigcal/report/json.h"
 #include "rigcal/rig/rig_yaml.h"
 #include "sample_rig.h"
 
@@ -73,50 +69,10 @@ void run(const Options& o) {
   fs::remove_all(tmp, ec);
   fs::create_directories(tmp);
   try {
-    nlohmann::json truth;
-    truth["tool_version"] = version_string();
-    truth["seed"] = config.seed;
-    truth["target"] = {
-        {"name", config.target.name},
-        {"type",
-         config.target.type == camera::TargetType::checkerboard ? "checkerboard" : "aprilgrid"},
-        {"cols", config.target.cols},
-        {"rows", config.target.rows}};
-    Trajectory replay;
-    if (!config.replay_tum.empty()) replay = io::read_trajectory(config.replay_tum).trajectory;
-    for (const std::string& part : parts) {
-      const auto t0 = std::chrono::steady_clock::now();
-      fmt::print("simulating {} ...", part);
+    io::write_simulated_session(tmp, rig, config, parts, [](const std::string& text) {
+      fmt::print("{}", text);
       std::fflush(stdout);
-      if (part == "stereo") io::write_stereo(tmp, sim::simulate_stereo(rig, config), truth);
-      if (part == "lidar-camera")
-        io::write_lidar_camera(tmp, sim::simulate_lidar_camera(rig, config), truth);
-      if (part == "imu") io::write_imu(tmp, sim::simulate_imu_part(rig, config), truth);
-      if (part == "trajectories" || part == "ground-truth") {
-        const sim::TrajectoryPart t =
-            sim::simulate_trajectories(rig, config, config.replay_tum.empty() ? nullptr : &replay);
-        io::write_trajectories(tmp, t, truth);
-        if (config.trajectory_scans) {
-          sim::SweepDrive drive = sim::trajectory_drive(rig, config, t);
-          io::write_trajectory_scans(tmp, drive, t.truth_base.size(), truth,
-                                     [](size_t done, size_t total) {
-                                       if (done % 100 == 0 || done == total) {
-                                         fmt::print(" {}/{} sweeps", done, total);
-                                         std::fflush(stdout);
-                                       }
-                                     });
-          if (!drive.markers.empty()) io::write_markers(tmp, drive, t.T_enu_world, truth);
-        }
-      }
-      if (part == "scans") io::write_scans(tmp, sim::simulate_scans(rig, config), truth);
-      fmt::print(" {:.1f} s\n",
-                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-    }
-    io::write_files_atomic(
-        {{tmp / "truth.yaml", rig::rig_to_yaml(rig)},
-         {tmp / "truth.json", report::json_text(truth)},
-         {tmp / "target.yaml", io::target_to_yaml(config.target)},
-         {tmp / "session.yaml", io::simulated_session_yaml(parts, config.trajectory_scans)}});
+    });
     if (fs::exists(out, ec)) fs::remove_all(out);
     fs::rename(tmp, out);
   } catch (...) {

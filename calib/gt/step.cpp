@@ -365,4 +365,63 @@ nlohmann::json ground_truth_report(const GroundTruthRun& run, const StepInputs& 
   return j;
 }
 
+std::string ground_truth_summary(const GroundTruthRun& run, const nlohmann::json& report) {
+  std::string out;
+  const nlohmann::json& s = report["summary"];
+  out +=
+      fmt::format("poses: {}, path {:.1f} m; fixes: {} ({} RTK fixed), priors {} ({} rejected)\n",
+                  s["poses"].get<size_t>(), s["path_length_m"].get<double>(),
+                  s["fixes"].get<size_t>(), s["fixes_rtk_fixed"].get<size_t>(),
+                  s["priors"].get<size_t>(), s["priors_rejected"].get<size_t>());
+  for (const auto& [from, to] : run.graph.outages)
+    out += fmt::format("outage: {:.1f} s without a fix, bridged by the odometry\n",
+                       (to - from).seconds());
+  if (!s["prior_residual_horizontal_m"].is_null()) {
+    out += fmt::format("prior residuals: horizontal rms {:.1f} mm, vertical rms {:.1f} mm\n",
+                       1e3 * s["prior_residual_horizontal_m"]["rms"].get<double>(),
+                       1e3 * s["prior_residual_vertical_m"]["rms"].get<double>());
+  }
+  out += fmt::format("the fixes' error correlation time: {:.1f} s ({})\n", run.fix_correlation_s,
+                     s["fix_correlation"].get<std::string>());
+  if (!s["pose_sigma_horizontal_m"].is_null()) {
+    out += fmt::format(
+        "pose sigmas: horizontal median {:.1f} mm (max {:.1f}), yaw median {:.3f} deg\n",
+        1e3 * s["pose_sigma_horizontal_m"]["median"].get<double>(),
+        1e3 * s["pose_sigma_horizontal_m"]["max"].get<double>(),
+        s["pose_sigma_yaw_deg"]["median"].get<double>());
+  }
+  if (run.ba) {
+    const nlohmann::json& b = report["bundle_adjustment"];
+    out += fmt::format(
+        "bundle adjustment: {} windows in {:.1f} s; points off their planes rms {:.1f} mm before, "
+        "{:.1f} mm after (median over the windows); poses moved {:.1f} mm rms from the pose "
+        "graph's\n",
+        run.ba->windows.size(), run.ba->seconds,
+        1e3 * b["point_plane_rms_before_m"]["median"].get<double>(),
+        1e3 * b["point_plane_rms_after_m"]["median"].get<double>(),
+        1e3 * b["pose_change_from_stage1_m"]["rms"].get<double>());
+  }
+  if (run.map) {
+    out += fmt::format("map: {} points in {} m voxels from {} scans\n", run.map->points.size(),
+                       run.map->voxel_size_m, run.map->scans);
+  }
+  if (run.markers) {
+    const MarkerCheck& c = *run.markers;
+    out += fmt::format(
+        "markers: {} of {} found; distances between them against the survey's: rms "
+        "{:.1f} mm, max {:.1f} mm ({} pairs)\n",
+        c.found, c.cluster_of.size(), 1e3 * c.rms_error_m, 1e3 * c.max_error_m, c.pairs.size());
+  }
+  for (const nlohmann::json& n : report["notes"])
+    out += fmt::format("note: {}\n", n.get<std::string>());
+  return out;
+}
+
+std::filesystem::path default_gnss(const std::filesystem::path& recording) {
+  for (const char* name : {"gnss/poses.tum", "gnss/fixes.csv", "gnss/navsat.csv"})
+    if (fs::exists(recording / name)) return recording / name;
+  throw Error(fmt::format("{}: no gnss/poses.tum, gnss/fixes.csv or gnss/navsat.csv; give --gnss",
+                          recording.string()));
+}
+
 }  // namespace rigcal::gt

@@ -92,4 +92,13 @@ GroundTruthRun run_ground_truth(const StepInputs& inputs, const StepOptions& opt
 // (doc/ground-truth.md says what each number is).
 nlohmann::json ground_truth_report(const GroundTruthRun& run, const StepInputs& inputs);
 
+// What `rigcal ground-truth` prints of a run: poses, fixes and priors, outages, the priors'
+// residuals, the fixes' correlation time, the poses' sigmas, the bundle adjustment, the map and
+// the markers, the notes (from the report, ground_truth_report).
+std::string ground_truth_summary(const GroundTruthRun& run, const nlohmann::json& report);
+
+// The recording's GNSS file: gnss/poses.tum, gnss/fixes.csv or gnss/navsat.csv, the first there.
+// Throws rigcal::Error when none is.
+std::filesystem::path default_gnss(const std::filesystem::path& recording);
+
 }  // namespace rigcal::gt

@@ -3,15 +3,19 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstring>
 #include <opencv2/imgcodecs.hpp>
 
 #include "rigcal/core/error.h"
 #include "rigcal/core/text.h"
+#include "rigcal/core/version.h"
 #include "rigcal/io/files.h"
+#include "rigcal/io/target_yaml.h"
 #include "rigcal/io/trajectory_io.h"
 #include "rigcal/report/json.h"
 #include "rigcal/report/png.h"
+#include "rigcal/rig/rig_yaml.h"
 
 namespace rigcal::io {
 namespace fs = std::filesystem;
@@ -52,6 +56,52 @@ void write_points(const fs::path& dir, const std::vector<Time>& stamps,
 }
 
 }  // namespace
+
+void write_simulated_session(const fs::path& dir, const rig::Rig& rig, const sim::SimConfig& config,
+                             const std::vector<std::string>& parts,
+                             const std::function<void(const std::string&)>& say) {
+  nlohmann::json truth;
+  truth["tool_version"] = version_string();
+  truth["seed"] = config.seed;
+  truth["target"] = {
+      {"name", config.target.name},
+      {"type",
+       config.target.type == camera::TargetType::checkerboard ? "checkerboard" : "aprilgrid"},
+      {"cols", config.target.cols},
+      {"rows", config.target.rows}};
+  Trajectory replay;
+  if (!config.replay_tum.empty()) replay = io::read_trajectory(config.replay_tum).trajectory;
+  for (const std::string& part : parts) {
+    const auto t0 = std::chrono::steady_clock::now();
+    say(fmt::format("simulating {} ...", part));
+    if (part == "stereo") io::write_stereo(dir, sim::simulate_stereo(rig, config), truth);
+    if (part == "lidar-camera")
+      io::write_lidar_camera(dir, sim::simulate_lidar_camera(rig, config), truth);
+    if (part == "imu") io::write_imu(dir, sim::simulate_imu_part(rig, config), truth);
+    if (part == "trajectories" || part == "ground-truth") {
+      const sim::TrajectoryPart t =
+          sim::simulate_trajectories(rig, config, config.replay_tum.empty() ? nullptr : &replay);
+      io::write_trajectories(dir, t, truth);
+      if (config.trajectory_scans) {
+        sim::SweepDrive drive = sim::trajectory_drive(rig, config, t);
+        io::write_trajectory_scans(dir, drive, t.truth_base.size(), truth,
+                                   [&](size_t done, size_t total) {
+                                     if (done % 100 == 0 || done == total)
+                                       say(fmt::format(" {}/{} sweeps", done, total));
+                                   });
+        if (!drive.markers.empty()) io::write_markers(dir, drive, t.T_enu_world, truth);
+      }
+    }
+    if (part == "scans") io::write_scans(dir, sim::simulate_scans(rig, config), truth);
+    say(fmt::format(" {:.1f} s\n",
+                    std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
+  }
+  io::write_files_atomic(
+      {{dir / "truth.yaml", rig::rig_to_yaml(rig)},
+       {dir / "truth.json", report::json_text(truth)},
+       {dir / "target.yaml", io::target_to_yaml(config.target)},
+       {dir / "session.yaml", io::simulated_session_yaml(parts, config.trajectory_scans)}});
+}
 
 std::string simulated_session_yaml(const std::vector<std::string>& parts, bool trajectory_scans) {
   auto has = [&](std::string_view p) {

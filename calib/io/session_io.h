@@ -37,6 +37,14 @@ void write_trajectory_scans(const std::filesystem::path& dir, sim::SweepDrive& d
 void write_markers(const std::filesystem::path& dir, const sim::SweepDrive& drive,
                    const SE3& T_enu_world, nlohmann::json& truth);
 
+// The parts of a simulated session ("stereo", "lidar-camera", "imu", "trajectories",
+// "ground-truth", "scans") computed and written into `dir` in the session layout, with
+// truth.yaml, truth.json, target.yaml and session.yaml; `say` is told what is being done (a
+// part's name, its sweeps, its seconds).
+void write_simulated_session(const std::filesystem::path& dir, const rig::Rig& rig,
+                             const sim::SimConfig& config, const std::vector<std::string>& parts,
+                             const std::function<void(const std::string&)>& say);
+
 // session.yaml of a simulated session (doc/session.md) with the parts written ("stereo",
 // "lidar-camera", "imu", "trajectories", "scans"): the recordings of each step, target.yaml, and
 // the motion's GNSS/INS trajectory, and its odometry unless the motion recording has sweeps

@@ -80,6 +80,13 @@ inline GroundTruthScore simulated_ground_truth(const std::filesystem::path& dir,
   GroundTruthScore s;
   fs::remove_all(dir);
   fs::create_directories(dir);
+  // A command that failed ends the scoring with its status and message.
+  auto failed = [&s](const CliRun& r) {
+    if (r.status == 0) return false;
+    s.status = r.status;
+    s.err = r.err;
+    return true;
+  };
   std::ofstream(dir / "sim.yaml") << config_yaml;
   const CliRun sim =
       rigcal_cli(fmt::format("simulate --what ground-truth --seed {} --config {} "
@@ -87,22 +94,14 @@ inline GroundTruthScore simulated_ground_truth(const std::filesystem::path& dir,
                              seed, (dir / "sim.yaml").string(), (dir / "rec").string()),
                  dir);
   s.sim_seconds = sim.seconds;
-  if (sim.status != 0) {
-    s.status = sim.status;
-    s.err = sim.err;
-    return s;
-  }
+  if (failed(sim)) return s;
   const fs::path rec = dir / "rec";
   std::string args = gt_args;
   if (stages) {
     // rigcal's odometry once, for every stage.
     const CliRun odometry = rigcal_cli(
         fmt::format("odometry {} --out {}/odometry.tum", rec.string(), dir.string()), dir);
-    if (odometry.status != 0) {
-      s.status = odometry.status;
-      s.err = odometry.err;
-      return s;
-    }
+    if (failed(odometry)) return s;
     args += fmt::format(" --odometry {}/odometry.tum", dir.string());
     const Trajectory truth = io::read_trajectory(rec / "trajectories/truth_lidar.tum").trajectory;
     std::vector<io::StepCovariance> exact;
@@ -118,21 +117,13 @@ inline GroundTruthScore simulated_ground_truth(const std::filesystem::path& dir,
                     "--out {1}/exact_gt.txt --odometry {1}/exact.tum --no-bundle-adjustment {2}",
                     rec.string(), dir.string(), gt_args),
         dir);
-    if (bound.status != 0) {
-      s.status = bound.status;
-      s.err = bound.err;
-      return s;
-    }
+    if (failed(bound)) return s;
     const CliRun stage1 = rigcal_cli(
         fmt::format("ground-truth {0} --rig {0}/truth.yaml --gnss {0}/trajectories/gnss_ins.tum "
                     "--out {1}/stage1.txt --odometry {1}/odometry.tum --no-bundle-adjustment",
                     rec.string(), dir.string()),
         dir);
-    if (stage1.status != 0) {
-      s.status = stage1.status;
-      s.err = stage1.err;
-      return s;
-    }
+    if (failed(stage1)) return s;
   }
   const CliRun run = rigcal_cli(
       fmt::format("ground-truth {0} --rig {0}/truth.yaml --gnss {0}/trajectories/gnss_ins.tum "
