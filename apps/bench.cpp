@@ -11,7 +11,7 @@
 #include "rigcal/core/error.h"
 
 namespace rigcal::cli {
-namespace {
+namespace bench_command {
 
 void run_pair(const bench::BenchOptions& o) {
   for (const std::string& line : bench::pair_summary(o, bench::score_pair(o)))
@@ -31,9 +31,10 @@ void run_leaderboard(const bench::BenchOptions& o) {
   }
 }
 
-}  // namespace
+}  // namespace bench_command
 
 void add_bench(CLI::App& app) {
+  using namespace bench_command;
   auto o = std::make_shared<bench::BenchOptions>();
   CLI::App* cmd = app.add_subcommand(
       "bench",

@@ -14,7 +14,7 @@
 #include "step_output.h"
 
 namespace rigcal::cli {
-namespace {
+namespace calibrate_command {
 
 struct Options {
   session::CalibrateOptions run;
@@ -95,9 +95,10 @@ void run(Options o) {
   if (r.exit_status != 0) throw Exit{r.exit_status};
 }
 
-}  // namespace
+}  // namespace calibrate_command
 
 void add_calibrate(CLI::App& app) {
+  using namespace calibrate_command;
   auto o = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "calibrate",

@@ -11,7 +11,7 @@
 #include "step_output.h"
 
 namespace rigcal::cli {
-namespace {
+namespace cameras_command {
 
 struct Options {
   std::string target, session, model = "pinhole-radtan", rig, out, report, bayer;
@@ -59,9 +59,10 @@ void run(const Options& o) {
   fmt::print("wrote {} and {}/cameras.json, corners.vnl and PNGs\n", o.out, o.report);
 }
 
-}  // namespace
+}  // namespace cameras_command
 
 void add_cameras(CLI::App& app) {
+  using namespace cameras_command;
   auto o = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "cameras",

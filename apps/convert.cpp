@@ -11,7 +11,7 @@
 #include "step_output.h"
 
 namespace rigcal::cli {
-namespace {
+namespace convert_command {
 
 struct Options {
   std::vector<std::string> bags, topics, folders;
@@ -58,9 +58,10 @@ void run(const Options& o) {
   for (const auto& [topic, type] : r.skipped) fmt::print("  {} ({}): not converted\n", topic, type);
 }
 
-}  // namespace
+}  // namespace convert_command
 
 void add_convert(CLI::App& app) {
+  using namespace convert_command;
   auto o = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "convert",

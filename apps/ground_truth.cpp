@@ -16,7 +16,7 @@
 #include "step_output.h"
 
 namespace rigcal::cli {
-namespace {
+namespace ground_truth_command {
 namespace fs = std::filesystem;
 
 struct Options {
@@ -111,9 +111,10 @@ void run(const Options& o) {
   }
 }
 
-}  // namespace
+}  // namespace ground_truth_command
 
 void add_ground_truth(CLI::App& app) {
+  using namespace ground_truth_command;
   auto o = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "ground-truth",

@@ -13,7 +13,7 @@
 #include "step_output.h"
 
 namespace rigcal::cli {
-namespace {
+namespace hand_eye_command {
 
 struct Options {
   std::string lidar, scans, odometry_preset, gnss, session, sensor = "gnss", lidar_sensor = "lidar",
@@ -71,9 +71,10 @@ void run(const Options& o) {
   if (!o.report.empty()) fmt::print("report: {}/hand_eye.json and PNGs\n", o.report);
 }
 
-}  // namespace
+}  // namespace hand_eye_command
 
 void add_hand_eye(CLI::App& app) {
+  using namespace hand_eye_command;
   auto o = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "hand-eye",

@@ -11,7 +11,7 @@
 #include "step_output.h"
 
 namespace rigcal::cli {
-namespace {
+namespace lidar_camera_command {
 
 struct Options {
   std::string target, session, images, scans, rig, out, report, roi, board_size, bayer;
@@ -73,9 +73,10 @@ void run(Options o) {
   if (!o.report.empty()) fmt::print("report: {}/lidar_camera.json and pair_NN.png\n", o.report);
 }
 
-}  // namespace
+}  // namespace lidar_camera_command
 
 void add_lidar_camera(CLI::App& app) {
+  using namespace lidar_camera_command;
   auto o = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "lidar-camera",

@@ -12,13 +12,14 @@
 #include "rigcal/core/text.h"
 #include "rigcal/core/version.h"
 
-namespace {
+namespace main_command {
 // A message quotes what it was given (a key, a value, a path): on stderr it stays one line of
 // valid text, whatever bytes the input held.
 std::string one_line(const char* message) { return rigcal::printable(message, 2000); }
-}  // namespace
+}  // namespace main_command
 
 int main(int argc, char** argv) {
+  using namespace main_command;
   // OpenCV's warnings (a decoder's "can't read data" before rigcal's own error on the same file)
   // are not rigcal's one line: only its errors are kept.
   cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);

@@ -13,7 +13,7 @@
 #include "step_output.h"
 
 namespace rigcal::cli {
-namespace {
+namespace odometry_command {
 
 struct Options {
   std::string recording, out, covariances, report, sensor = "os0-128";
@@ -63,9 +63,10 @@ void run(const Options& o) {
                  : fmt::format("; report {}/odometry.json and its figures (.svg)", o.report));
 }
 
-}  // namespace
+}  // namespace odometry_command
 
 void add_odometry(CLI::App& app) {
+  using namespace odometry_command;
   auto o = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "odometry",

@@ -11,7 +11,7 @@
 #include "rigcal/core/text.h"
 
 namespace rigcal::cli {
-namespace {
+namespace publish_command {
 
 struct Options {
   std::string calibration, formats = "vbr";
@@ -40,9 +40,10 @@ void run(const Options& o) {
   }
 }
 
-}  // namespace
+}  // namespace publish_command
 
 void add_publish(CLI::App& app) {
+  using namespace publish_command;
   auto o = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "publish",

@@ -8,15 +8,16 @@
 #include "rigcal/rig/rig_yaml.h"
 
 namespace rigcal::cli {
-namespace {
+namespace rig_convert_command {
 
 struct Options {
   std::string file, to, out, imu;
 };
 
-}  // namespace
+}  // namespace rig_convert_command
 
 void add_rig_convert(CLI::App& parent) {
+  using namespace rig_convert_command;
   auto o = std::make_shared<Options>();
   CLI::App* cmd = parent.add_subcommand(
       "convert",

@@ -10,7 +10,7 @@
 #include "rigcal/session/provenance.h"
 
 namespace rigcal::cli {
-namespace {
+namespace rig_show_command {
 
 constexpr double kDeg = 180.0 / M_PI;
 
@@ -102,9 +102,10 @@ void print_rig(const std::string& file, const rig::Rig& r) {
   }
 }
 
-}  // namespace
+}  // namespace rig_show_command
 
 void add_rig_show(CLI::App& parent) {
+  using namespace rig_show_command;
   auto file = std::make_shared<std::string>();
   CLI::App* cmd = parent.add_subcommand(
       "show",

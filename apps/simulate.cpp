@@ -16,7 +16,7 @@
 #include "sample_rig.h"
 
 namespace rigcal::cli {
-namespace {
+namespace simulate_command {
 
 namespace fs = std::filesystem;
 
@@ -82,9 +82,10 @@ void run(const Options& o) {
   fmt::print("wrote {} (truth: {}/truth.yaml, {}/truth.json)\n", o.out, o.out, o.out);
 }
 
-}  // namespace
+}  // namespace simulate_command
 
 void add_simulate(CLI::App& app) {
+  using namespace simulate_command;
   auto o = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "simulate",

@@ -10,7 +10,7 @@
 #include "step_output.h"
 
 namespace rigcal::cli {
-namespace {
+namespace time_offset_command {
 
 void run(const time_sync::ClockRequest& o) {
   const time_sync::ClockRun run = time_sync::resolve_clock_request(o);
@@ -29,9 +29,10 @@ void run(const time_sync::ClockRequest& o) {
   if (!o.report.empty()) fmt::print("report: {}/time_sync.json and PNGs\n", o.report);
 }
 
-}  // namespace
+}  // namespace time_offset_command
 
 void add_time_offset(CLI::App& app) {
+  using namespace time_offset_command;
   auto o = std::make_shared<time_sync::ClockRequest>();
   CLI::App* cmd = app.add_subcommand(
       "time-offset",

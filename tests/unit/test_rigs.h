@@ -70,3 +70,9 @@ inline Rig random_rig(std::mt19937_64& rng) {
 }
 
 }  // namespace rigcal::rig::testing
+
+namespace rigcal {
+// The bundled sample rig (the simulator's truth) and the prior a session starts from.
+inline const std::string kTruth = RIGCAL_SOURCE_DIR "/data/sample_rig.yaml";
+inline const std::string kPrior = RIGCAL_SOURCE_DIR "/data/sample_prior_rig.yaml";
+}  // namespace rigcal

@@ -33,6 +33,7 @@
 #include "rigcal/rig/rig_yaml.h"
 #include "rigcal/session/provenance.h"
 #include "rigcal/session/publish.h"
+#include "test_rigs.h"
 
 namespace rigcal {
 namespace {
@@ -133,8 +134,6 @@ class Session : public ::testing::Test {
   fs::path dir_;
 };
 
-const std::string kPrior = RIGCAL_SOURCE_DIR "/data/sample_prior_rig.yaml";
-const std::string kTruth = RIGCAL_SOURCE_DIR "/data/sample_rig.yaml";
 
 double rotation_error_deg(const SE3& a, const SE3& b) {
   return rotation_angle(a.R.transpose() * b.R) * 180.0 / M_PI;

@@ -18,14 +18,13 @@
 #include "rigcal/lidar_camera/step.h"
 #include "rigcal/rig/rig_yaml.h"
 #include "rigcal/time_sync/step.h"
+#include "test_rigs.h"
 
 namespace rigcal {
 namespace {
 
 namespace fs = std::filesystem;
 
-const std::string kTruth = RIGCAL_SOURCE_DIR "/data/sample_rig.yaml";
-const std::string kPrior = RIGCAL_SOURCE_DIR "/data/sample_prior_rig.yaml";
 
 class Steps : public ::testing::Test {
  protected:
