@@ -25,7 +25,7 @@ struct Options {
   std::string gnss_sensor = "gnss", odometry_preset;
   double max_fix_gap_s = 0.5;
   std::string fix_correlation = "auto";
-  bool no_bundle_adjustment = false;
+  bool no_bundle_adjustment = false, photometric = false, no_fusion = false;
   size_t window_scans = gt::SequenceBaConfig{}.window_scans;
   size_t window_overlap = gt::SequenceBaConfig{}.overlap_scans;
 };
@@ -55,6 +55,8 @@ void run(const Options& o) {
   options.bundle_adjustment = !o.no_bundle_adjustment;
   options.ba.window_scans = o.window_scans;
   options.ba.overlap_scans = o.window_overlap;
+  options.ba.window.photometric.enabled = o.photometric;
+  options.fuse_odometry = !o.no_fusion;
   options.map = !o.map.empty();
   options.map_config.voxel_size_m = o.map_voxel_m;
   options.map_config.bright_intensity = o.marker_intensity;
@@ -164,6 +166,14 @@ void add_ground_truth(CLI::App& app) {
                   "the scans (a folder, a capture, a recording; default: the recording's)");
   cmd->add_flag("--no-bundle-adjustment", o->no_bundle_adjustment,
                 "stop at the pose graph (stage 1)");
+  cmd->add_flag("--no-fusion", o->no_fusion,
+                "take the bundle adjustment's motions alone into the second pose graph (default: "
+                "each fused with the odometry's by covariance intersection where the two agree "
+                "within their covariances)");
+  cmd->add_flag("--photometric", o->photometric,
+                "add the photometric term to each window (range and intensity between the "
+                "scans' spherical images, after the geometric rounds; doc/ground-truth.md "
+                "measures what it adds)");
   cmd->add_option("--window-scans", o->window_scans, "scans a bundle-adjustment window")
       ->check(CLI::Range(size_t(2), size_t(1000)))
       ->capture_default_str();

@@ -115,7 +115,8 @@ SequenceBaResult sequence_ba(const std::function<std::optional<Scan>()>& next_sc
       const WindowBaResult& ba = results[i - i0];
       out.windows.push_back({plan.first[i], plan.end[i] - plan.first[i], ba.rounds, ba.patches,
                              ba.residuals, ba.rms_before_m, ba.rms_after_m,
-                             !ba.step_covariance.empty(), seconds[i - i0]});
+                             !ba.step_covariance.empty(), seconds[i - i0], ba.photometric_residuals,
+                             ba.photometric_sigma_range_m, ba.photometric_sigma_intensity});
       if (ba.step_covariance.empty()) continue;
       for (size_t k = plan.first[i]; k < plan.end[i]; ++k) {
         if (plan.owner[k] != i) continue;

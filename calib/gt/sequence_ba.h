@@ -34,6 +34,9 @@ struct WindowSummary {
   double rms_before_m = 0, rms_after_m = 0;
   bool covariances = false;  // false: its motions could not be weighed, the odometry's kept
   double seconds = 0;
+  // With the photometric term (WindowBaResult's figures).
+  size_t photometric_residuals = 0;
+  double photometric_sigma_range_m = 0, photometric_sigma_intensity = 0;
 };
 
 struct SequenceBaResult {

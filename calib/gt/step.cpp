@@ -169,7 +169,22 @@ GroundTruthRun run_ground_truth(const StepInputs& in, const StepOptions& o,
     }
     report::tell(progress, "solving the pose graph of the adjusted motions", 0, 1);
     run.stage1 = std::move(run.graph);
-    run.graph = solve(run.ba->motions);
+    if (o.fuse_odometry) {
+      FusedMotions fused = fuse_motions(odometry, run.ba->motions);
+      run.odometry_weight = std::move(fused.weight_a);
+      run.fusion_disagreeing_fraction = fused.disagreeing_fraction;
+      run.fused = fused.fused;
+      if (!fused.fused) {
+        run.notes.push_back(fmt::format(
+            "the odometry's and the adjustment's motions differ by more than their covariances "
+            "allow in {:.1f} % of the steps (1 % expected): one of them claims more than it has, "
+            "so the adjustment's motions are taken alone",
+            100 * fused.disagreeing_fraction));
+      }
+      run.graph = solve(fused.motions);
+    } else {
+      run.graph = solve(run.ba->motions);
+    }
     report::tell(progress, "solving the pose graph of the adjusted motions", 1, 1);
   }
   // The map, placed by the result, and the markers in it.
@@ -277,6 +292,10 @@ nlohmann::json ground_truth_report(const GroundTruthRun& run, const StepInputs& 
                          {"point_plane_rms_after_m", w.rms_after_m},
                          {"covariances", w.covariances},
                          {"seconds", w.seconds}});
+      if (ba.config.window.photometric.enabled)
+        windows.back()["photometric"] = {{"residuals", w.photometric_residuals},
+                                         {"sigma_range_m", w.photometric_sigma_range_m},
+                                         {"sigma_intensity", w.photometric_sigma_intensity}};
     }
     // How far the adjustment moved the poses from stage 1's.
     std::vector<double> moved_m, turned_deg;
@@ -292,7 +311,8 @@ nlohmann::json ground_truth_report(const GroundTruthRun& run, const StepInputs& 
                                 {"overlap_scans", ba.config.overlap_scans},
                                 {"knots_per_sweep", ba.config.window.knots_per_sweep},
                                 {"voxel_size_m", ba.config.window.voxel_size_m},
-                                {"point_sigma_m", ba.config.window.point_sigma_m}}},
+                                {"point_sigma_m", ba.config.window.point_sigma_m},
+                                {"photometric", ba.config.window.photometric.enabled}}},
                               {"point_plane_rms_before_m", stats(before)},
                               {"point_plane_rms_after_m", stats(after)},
                               {"motions_from_odometry", ba.motions_from_odometry},
@@ -301,6 +321,17 @@ nlohmann::json ground_truth_report(const GroundTruthRun& run, const StepInputs& 
                               {"rotation_change_from_stage1_deg", stats(turned_deg)},
                               {"seconds", ba.seconds},
                               {"per_window", std::move(windows)}};
+    if (!run.odometry_weight.empty()) {
+      const size_t odometry_first =
+          size_t(std::count_if(run.odometry_weight.begin(), run.odometry_weight.end(),
+                               [](double w) { return w > 0.5; }));
+      j["bundle_adjustment"]["fusion_with_odometry"] = {
+          {"method", "covariance intersection a step, weight w on the odometry's information"},
+          {"odometry_weight", stats(run.odometry_weight)},
+          {"steps_weighing_the_odometry_more", odometry_first},
+          {"fused", run.fused},
+          {"steps_beyond_99_percent_fraction", run.fusion_disagreeing_fraction}};
+    }
   }
   if (run.map) {
     const LidarMap& m = *run.map;

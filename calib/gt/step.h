@@ -13,6 +13,7 @@
 
 #include "rigcal/gt/map.h"
 #include "rigcal/gt/markers.h"
+#include "rigcal/gt/motion_fusion.h"
 #include "rigcal/gt/pose_graph.h"
 #include "rigcal/gt/sequence_ba.h"
 #include "rigcal/io/gnss_fixes.h"
@@ -31,6 +32,10 @@ struct StepOptions {
   // Stage 2 on StepInputs::scans (skipped, with a note, when there are none).
   bool bundle_adjustment = true;
   SequenceBaConfig ba;
+  // Each adjusted motion fused with the odometry's by covariance intersection (motion_fusion.h)
+  // before the second pose graph; false: the adjusted motions alone (doc/ground-truth.md
+  // measures both).
+  bool fuse_odometry = true;
   // The map of the scans placed by the result (map.h): built when asked, or when a markers'
   // survey is given.
   bool map = false;
@@ -60,6 +65,12 @@ struct GroundTruthRun {
   // With the bundle adjustment: its windows, and the pose graph of stage 1 it started from.
   std::optional<SequenceBaResult> ba;
   std::optional<PoseGraphResult> stage1;
+  // With the fusion: each step's weight on the odometry (0: the adjustment's motion alone).
+  std::vector<double> odometry_weight;
+  // The fusion's test of the two covariances: the steps whose motions differ by more than the
+  // 99 % quantile; above 5 %, no fusion (motion_fusion.h).
+  double fusion_disagreeing_fraction = 0;
+  bool fused = false;
   std::vector<PositionFix> fixes;
   Eigen::Vector3d p_lidar_antenna = Eigen::Vector3d::Zero();
   std::optional<io::GeodeticOrigin> origin;    // of the ENU frame, when the GNSS gave fixes

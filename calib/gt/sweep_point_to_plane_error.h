@@ -18,6 +18,28 @@
 
 namespace rigcal::gt {
 
+// The point p_lidar measured a fraction f of the way from knot a to knot b, placed in the world
+// by the interpolated pose (T_world_a, T_world_b as Eigen quaternions x y z w and translations).
+template <class T>
+Eigen::Matrix<T, 3, 1> sweep_point_in_world(const T* q_world_a, const T* t_world_a,
+                                            const T* q_world_b, const T* t_world_b,
+                                            const Eigen::Vector3d& p_lidar, double fraction) {
+  const Eigen::Map<const Eigen::Quaternion<T>> qa(q_world_a), qb(q_world_b);
+  const Eigen::Map<const Eigen::Matrix<T, 3, 1>> ta(t_world_a), tb(t_world_b);
+  const Eigen::Quaternion<T> q_a_b = qa.conjugate() * qb;
+  // ceres' order is w x y z; the shorter way round (q and -q are one rotation).
+  const T sign = q_a_b.w() < T(0) ? T(-1) : T(1);
+  const T wxyz[4] = {sign * q_a_b.w(), sign * q_a_b.x(), sign * q_a_b.y(), sign * q_a_b.z()};
+  T phi[3];
+  ceres::QuaternionToAngleAxis(wxyz, phi);
+  for (T& c : phi) c *= T(fraction);
+  const T p[3] = {T(p_lidar.x()), T(p_lidar.y()), T(p_lidar.z())};
+  T p_turned[3];
+  ceres::AngleAxisRotatePoint(phi, p, p_turned);
+  const Eigen::Map<const Eigen::Matrix<T, 3, 1>> p_a(p_turned);
+  return qa * p_a + ta + T(fraction) * (tb - ta);
+}
+
 struct SweepPointToPlaneError {
   Eigen::Vector3d p_lidar;  // the point in the sensor frame at its own time
   double fraction = 0;      // its time from knot a, over the time from knot a to knot b
@@ -27,20 +49,9 @@ struct SweepPointToPlaneError {
   template <class T>
   bool operator()(const T* q_world_a, const T* t_world_a, const T* q_world_b, const T* t_world_b,
                   const T* plane, T* residual) const {
-    const Eigen::Map<const Eigen::Quaternion<T>> qa(q_world_a), qb(q_world_b);
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> ta(t_world_a), tb(t_world_b), n(plane);
-    const Eigen::Quaternion<T> q_a_b = qa.conjugate() * qb;
-    // ceres' order is w x y z; the shorter way round (q and -q are one rotation).
-    const T sign = q_a_b.w() < T(0) ? T(-1) : T(1);
-    const T wxyz[4] = {sign * q_a_b.w(), sign * q_a_b.x(), sign * q_a_b.y(), sign * q_a_b.z()};
-    T phi[3];
-    ceres::QuaternionToAngleAxis(wxyz, phi);
-    for (T& c : phi) c *= T(fraction);
-    const T p[3] = {T(p_lidar.x()), T(p_lidar.y()), T(p_lidar.z())};
-    T p_turned[3];
-    ceres::AngleAxisRotatePoint(phi, p, p_turned);
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> p_a(p_turned);
-    const Eigen::Matrix<T, 3, 1> p_world = qa * p_a + ta + T(fraction) * (tb - ta);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> n(plane);
+    const Eigen::Matrix<T, 3, 1> p_world =
+        sweep_point_in_world(q_world_a, t_world_a, q_world_b, t_world_b, p_lidar, fraction);
     residual[0] = T(inv_sigma) * (n.dot(p_world - c_world.cast<T>()) - plane[3]);
     return true;
   }

@@ -12,6 +12,7 @@
 #include <unordered_map>
 
 #include "rigcal/core/error.h"
+#include "rigcal/gt/photometric_error.h"
 #include "rigcal/gt/point_to_plane_error.h"
 #include "rigcal/gt/sweep_point_to_plane_error.h"
 #include "rigcal/lidar/preprocess.h"
@@ -25,6 +26,7 @@ struct SweepPoint {
   Eigen::Vector3d p_lidar;
   uint32_t knot = 0;
   double fraction = 0;
+  float intensity = 0;
 };
 using ScanPoints = std::vector<SweepPoint>;
 
@@ -211,6 +213,108 @@ std::vector<Matrix6d> step_covariances(ceres::Problem& problem, std::vector<Knot
   return out;
 }
 
+// 1.4826 median absolute deviations from the median: the residuals' sigma, robust to outliers.
+double robust_sigma(std::vector<double> r) {
+  if (r.empty()) return 0;
+  auto median = [](std::vector<double>& v) {
+    std::nth_element(v.begin(), v.begin() + Eigen::Index(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
+  const double m = median(r);
+  for (double& e : r) e = std::abs(e - m);
+  return 1.4826 * median(r);
+}
+
+// The images of the scans as the knots place them (each in its scan knot's frame), and the
+// photometric residuals of each scan's points against the `reference_scans` images before it,
+// added to `problem`. The images are kept in `images` and `references` (the residuals read them).
+void add_photometric(ceres::Problem& problem, const std::vector<ScanPoints>& dense,
+                     const std::vector<ScanPoints>& points, std::vector<Knot>& x,
+                     const std::vector<SE3>& T_world_knot, const std::vector<size_t>& scan_knot,
+                     const SphericalProjection& projection, const PhotometricConfig& config,
+                     std::vector<SphericalImage>& images,
+                     std::vector<std::unique_ptr<ReferenceImage>>& references,
+                     WindowBaResult& out) {
+  const auto dense_world = placed(dense, T_world_knot);
+  for (size_t i = 0; i < dense.size(); ++i) {
+    const SE3 T_knot_world = T_world_knot[scan_knot[i]].inverse();
+    std::vector<Eigen::Vector3d> p_knot;
+    std::vector<float> intensity;
+    for (size_t k = 0; k < dense[i].size(); ++k) {
+      p_knot.push_back(T_knot_world * dense_world[i][k]);
+      intensity.push_back(dense[i][k].intensity);
+    }
+    images.push_back(spherical_image(p_knot, intensity, projection));
+  }
+  for (const SphericalImage& image : images)
+    references.push_back(std::make_unique<ReferenceImage>(image));
+  // The usable points of each pair, at the knots as they are, and their residuals' spread.
+  struct Use {
+    size_t ref = 0, knot = 0;  // the reference scan; the knot before the point's time
+    PhotometricError error;
+  };
+  std::vector<Use> uses;
+  std::vector<double> r_range, r_intensity;
+  const int rows = projection.rows, cols = projection.cols;
+  for (size_t j = 1; j < points.size(); ++j) {
+    for (size_t i = j > size_t(config.reference_scans) ? j - size_t(config.reference_scans) : 0;
+         i < j; ++i) {
+      const SphericalImage& image = images[i];
+      std::vector<Use> pair;
+      for (const SweepPoint& p : points[j]) {
+        PhotometricError e{references[i].get(), p.p_lidar, p.fraction, p.intensity, 1.0, 1.0};
+        const Eigen::Vector3d p_ref =
+            T_world_knot[scan_knot[i]].inverse() *
+            sweep_point_in_world(x[p.knot].data(), x[p.knot].data() + 4, x[p.knot + 1].data(),
+                                 x[p.knot + 1].data() + 4, p.p_lidar, p.fraction);
+        double u = 0, v = 0;
+        projection.project(p_ref, &u, &v);
+        const int c0 = int(std::floor(u)) - 1, r0 = int(std::floor(v)) - 1;
+        if (c0 < 0 || c0 + 3 >= cols || r0 < 0 || r0 + 3 >= rows) continue;
+        double lo = INFINITY, hi = 0;
+        for (int r = r0; r < r0 + 4; ++r)
+          for (int c = c0; c < c0 + 4; ++c) {
+            const double range = image.range_m[size_t(r) * size_t(cols) + size_t(c)];
+            lo = std::min(lo, range), hi = std::max(hi, range);
+          }
+        const double range = p_ref.norm();
+        if (!(lo > 0) || hi - lo > config.max_range_spread * range) continue;
+        double residual[2];
+        e(x[scan_knot[i]].data(), x[p.knot].data(), x[p.knot + 1].data(), residual);
+        if (!(std::abs(residual[0]) < config.max_range_error_m)) continue;
+        pair.push_back({i, p.knot, e});
+      }
+      const size_t n = std::min(pair.size(), config.max_points);
+      for (size_t k = 0; k < n; ++k) uses.push_back(pair[k * pair.size() / n]);
+    }
+  }
+  for (const Use& use : uses) {
+    double residual[2];
+    use.error(x[scan_knot[use.ref]].data(), x[use.knot].data(), x[use.knot + 1].data(), residual);
+    r_range.push_back(residual[0]);
+    r_intensity.push_back(residual[1]);
+  }
+  const double sigma_range = std::max(1e-3, robust_sigma(r_range));
+  const double sigma_intensity = std::max(1e-3, robust_sigma(r_intensity));
+  for (const Use& use : uses) {
+    PhotometricError e = use.error;
+    e.inv_sigma_range = config.range_weight / sigma_range;
+    e.inv_sigma_intensity = config.intensity_weight / sigma_intensity;
+    double* blocks[3] = {x[scan_knot[use.ref]].data(), x[use.knot].data(), x[use.knot + 1].data()};
+    for (double* b : blocks) {
+      if (problem.HasParameterBlock(b)) continue;
+      problem.AddParameterBlock(b, 7, new KnotManifold);
+      if (b == x[0].data()) problem.SetParameterBlockConstant(b);
+    }
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<PhotometricError, 2, 7, 7, 7>(new PhotometricError(e)),
+        new ceres::HuberLoss(config.huber_sigmas), blocks[0], blocks[1], blocks[2]);
+  }
+  out.photometric_residuals = uses.size();
+  out.photometric_sigma_range_m = sigma_range;
+  out.photometric_sigma_intensity = sigma_intensity;
+}
+
 }  // namespace
 
 WindowBaResult window_ba(const std::vector<Scan>& scans, const std::vector<SE3>& T_world_lidar,
@@ -240,20 +344,32 @@ WindowBaResult window_ba(const std::vector<Scan>& scans, const std::vector<SE3>&
   scan_knot.push_back(T_world_knot.size());
   T_world_knot.push_back(T_world_lidar.back());
 
-  std::vector<ScanPoints> points(scans.size());
+  // Each point with its knot and fraction: the voxel samples the adjustment uses (`points`) and,
+  // for the photometric term's images, every point in range (`dense`).
+  const bool photometric = config.photometric.enabled;
+  std::vector<ScanPoints> points(scans.size()), dense(photometric ? scans.size() : 0);
   for (size_t k = 0; k < scans.size(); ++k) {
     const Time next = k + 1 < scans.size() ? scans[k + 1].stamp : end;
     const double span_ns = double((next - scans[k].stamp).ns);
     const bool timed = config.sweep_motion && scans[k].point_times;
-    for (const ScanPoint& p : lidar::voxel_sample(scans[k].points, config.voxel_size_m,
-                                                  config.min_range_m, config.max_range_m)) {
+    auto sweep_point = [&](const ScanPoint& p) {
       const double f = timed ? std::clamp(double(p.t_ns) / span_ns, 0.0, 1.0) * double(m) : 0.0;
       const size_t j = std::min(size_t(f), m - 1);
       SweepPoint point;
       point.p_lidar = p.p.cast<double>();
       point.knot = uint32_t(scan_knot[k] + j);
       point.fraction = f - double(j);
-      points[k].push_back(point);
+      point.intensity = p.intensity;
+      return point;
+    };
+    for (const ScanPoint& p : lidar::voxel_sample(scans[k].points, config.voxel_size_m,
+                                                  config.min_range_m, config.max_range_m))
+      points[k].push_back(sweep_point(p));
+    if (!photometric) continue;
+    for (const ScanPoint& p : scans[k].points) {
+      const double range = double(p.p.norm());
+      if (range >= config.min_range_m && range <= config.max_range_m)
+        dense[k].push_back(sweep_point(p));
     }
   }
 
@@ -337,6 +453,32 @@ WindowBaResult window_ba(const std::vector<Scan>& scans, const std::vector<SE3>&
     out.patches = a.planes.size();
     out.residuals = a.points.size();
     if (moved < config.converged_m) break;
+  }
+  // The photometric term, with the last round's geometric residuals.
+  std::vector<SphericalImage> images;
+  std::vector<std::unique_ptr<ReferenceImage>> references;
+  const SphericalProjection projection =
+      photometric ? spherical_projection(scans.front()) : SphericalProjection{};
+  if (photometric && last && projection.rows > 0) {
+    add_photometric(*last, dense, points, x, T_world_knot, scan_knot, projection,
+                    config.photometric, images, references, out);
+    auto* ordering = new ceres::ParameterBlockOrdering;
+    for (Eigen::Vector4d& p : plane)
+      if (last->HasParameterBlock(p.data())) ordering->AddElementToGroup(p.data(), 0);
+    for (size_t k = 0; k < knots; ++k)
+      if (last->HasParameterBlock(x[k].data())) ordering->AddElementToGroup(x[k].data(), 1);
+    ceres::Solver::Options options;
+    options.linear_solver_type = ceres::DENSE_SCHUR;
+    options.linear_solver_ordering.reset(ordering);
+    options.max_num_iterations = config.photometric.iterations;
+    options.num_threads = threads(config);
+    ceres::Solver::Summary summary;
+    ceres::Solve(options, last.get(), &summary);
+    if (!summary.IsSolutionUsable())
+      throw Error("window bundle adjustment: the photometric solve failed: " + summary.message);
+    for (size_t k = 1; k < knots; ++k)
+      if (last->HasParameterBlock(x[k].data())) T_world_knot[k] = knot_pose(x[k]);
+    for (size_t k = 0; k < scan_knot.size(); ++k) out.T_world_lidar[k] = T_world_knot[scan_knot[k]];
   }
   const auto world = placed(points, T_world_knot);
   out.rms_after_m = rms_distance(associate(world, config), world);

@@ -24,6 +24,28 @@
 
 namespace rigcal::gt {
 
+// The photometric term (photometric_error.h), solved after the geometric rounds together with the
+// last round's geometric residuals: each scan's points against the spherical images of the
+// scans before it. Off by default: on the simulated walks and drives it changes the ground
+// truth by less than its error (doc/ground-truth.md, the figures).
+struct PhotometricConfig {
+  bool enabled = false;
+  int reference_scans = 2;   // each scan's points against the images of this many before it
+  size_t max_points = 1500;  // of a scan against one image, evenly spread over those usable
+  // A point is used where its pixel's 4 x 4 neighbourhood (what the bicubic interpolation reads)
+  // holds ranges all within this fraction of its range (no edge, no empty pixel) and its range
+  // there within `max_range_error_m` of its own (not occluded, not another surface).
+  double max_range_spread = 0.1;
+  double max_range_error_m = 0.3;
+  double huber_sigmas = 3.0;  // on each point's residual, in the residuals' own sigmas
+  // Each residual over its sigma, times its weight. The intensity's is low: a surface's intensity
+  // changes with the angle it is seen at, from one scan to the next by more than its noise, and
+  // weighed by its noise alone (1.8 units on the simulator's walk) it pulls the knots 2 cm off
+  // the truth (doc/ground-truth.md). MD-SLAM weighs intensity 0.2 against range 0.9.
+  double range_weight = 1.0, intensity_weight = 0.2;
+  int iterations = 10;
+};
+
 struct WindowBaConfig {
   double voxel_size_m = 0.2;  // each scan's points downsampled to the first one of each voxel
   double min_range_m = 0.5, max_range_m = 120.0;  // of the points kept
@@ -51,6 +73,7 @@ struct WindowBaConfig {
   // The covariance of each motion between consecutive knots (WindowBaResult::step_covariance).
   bool step_covariances = false;
   int threads = 0;  // of the solver; 0: one a core
+  PhotometricConfig photometric;
 };
 
 struct WindowBaResult {
@@ -66,6 +89,10 @@ struct WindowBaResult {
   // residuals' variance over point_sigma_m^2 when that is larger than 1. Empty when the
   // information is singular (a knot no point depends on, a scene without planes enough).
   std::vector<Matrix6d> step_covariance;
+  // With the photometric term: its residuals, and their noise as measured before its solve
+  // (1.4826 median absolute deviations), by which each is weighed.
+  size_t photometric_residuals = 0;
+  double photometric_sigma_range_m = 0, photometric_sigma_intensity = 0;
 };
 
 // `scans`: in time order, each point in the sensor frame at its own time (Scan::point_times false,

@@ -19,6 +19,7 @@
 #include "rigcal/bench/metrics.h"
 #include "rigcal/core/error.h"
 #include "rigcal/core/stats.h"
+#include "rigcal/gt/motion_fusion.h"
 #include "rigcal/gt/pose_graph.h"
 #include "rigcal/io/gnss_fixes.h"
 #include "rigcal/io/odometry_io.h"
@@ -511,6 +512,102 @@ TEST(PoseGraph, TheFixesCorrelationTimeFromResiduals) {
     EXPECT_LT(e, 7.0);
   }
   EXPECT_EQ(gt::estimate_fix_correlation({}), 0.0);
+}
+
+// Two estimates of 2000 motions, each step's errors drawn from its own covariance: a good along
+// x and in yaw, poor along y; b the other way round (the car's odometry along the road, the
+// adjustment across). Fused a step at a time by covariance intersection: better than either in
+// every direction they are not both poor in, and the fused sigmas honest; with one estimate
+// better in every direction, the weight goes to it alone; with one claiming less noise than it
+// has, no fusion.
+TEST(MotionFusion, CovarianceIntersectionTakesTheBetterEstimateInEachDirection) {
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> N(0.0, 1.0);
+  using Vector6d = Eigen::Matrix<double, 6, 1>;
+  auto draw = [&](const Vector6d& sigma) {
+    Vector6d e;
+    for (int i = 0; i < 6; ++i) e[i] = sigma[i] * N(rng);
+    return e;
+  };
+  Vector6d sigma_a, sigma_b;
+  sigma_a << 0.001, 0.001, 0.0002, 0.001, 0.02, 0.005;  // rotation (rad), translation (m)
+  sigma_b << 0.001, 0.001, 0.002, 0.02, 0.002, 0.005;
+  const size_t n = 2000;
+  gt::OdometryInput a, b;
+  std::vector<SE3> truth_steps;
+  for (gt::OdometryInput* o : {&a, &b}) o->T_odom_lidar.T_world_body.push_back(SE3{});
+  for (size_t k = 0; k <= n; ++k) {
+    a.T_odom_lidar.stamps.push_back(Time::from_seconds(0.1 * double(k)));
+    if (k == n) break;
+    const SE3 step = SE3::from_rotation_vector(Eigen::Vector3d(0.01, -0.02, 0.05 * N(rng)),
+                                               Eigen::Vector3d(0.8, 0.05 * N(rng), 0.01));
+    truth_steps.push_back(step);
+    a.T_odom_lidar.T_world_body.push_back(a.T_odom_lidar.T_world_body.back() *
+                                          perturbed(step, draw(sigma_a)));
+    b.T_odom_lidar.T_world_body.push_back(b.T_odom_lidar.T_world_body.back() *
+                                          perturbed(step, draw(sigma_b)));
+    a.step_covariance.push_back(sigma_a.cwiseAbs2().asDiagonal());
+    b.step_covariance.push_back(sigma_b.cwiseAbs2().asDiagonal());
+  }
+  b.T_odom_lidar.stamps = a.T_odom_lidar.stamps;
+  const gt::FusedMotions fused = gt::fuse_motions(a, b);
+  ASSERT_EQ(fused.motions.T_odom_lidar.size(), n + 1);
+  ASSERT_EQ(fused.weight_a.size(), n);
+  // The errors of each estimate's steps, per axis, and the fused one's within its 3 sigma.
+  Vector6d sq_a = Vector6d::Zero(), sq_b = sq_a, sq_f = sq_a;
+  size_t within = 0;
+  auto error = [](const Trajectory& t, size_t k, const SE3& truth) {
+    const SE3 m = t.T_world_body[k].inverse() * t.T_world_body[k + 1];
+    Vector6d d;
+    d << rotation_vector(m.R * truth.R.transpose()), m.t - truth.t;
+    return d;
+  };
+  for (size_t k = 0; k < n; ++k) {
+    sq_a += error(a.T_odom_lidar, k, truth_steps[k]).cwiseAbs2();
+    sq_b += error(b.T_odom_lidar, k, truth_steps[k]).cwiseAbs2();
+    const Vector6d e = error(fused.motions.T_odom_lidar, k, truth_steps[k]);
+    sq_f += e.cwiseAbs2();
+    const Vector6d sigma = fused.motions.step_covariance[k].diagonal().cwiseSqrt();
+    for (int i = 0; i < 6; ++i) within += std::abs(e[i]) < 3 * sigma[i];
+  }
+  const Vector6d rms_a = (sq_a / double(n)).cwiseSqrt(), rms_b = (sq_b / double(n)).cwiseSqrt(),
+                 rms_f = (sq_f / double(n)).cwiseSqrt();
+  std::printf(
+      "[ figures ] step errors rms, yaw (mrad), x, y (mm): a %.3f %.2f %.2f, b %.3f %.2f "
+      "%.2f, fused %.3f %.2f %.2f; weight on a %.2f; within 3 sigma %.1f %%\n",
+      1e3 * rms_a[2], 1e3 * rms_a[3], 1e3 * rms_a[4], 1e3 * rms_b[2], 1e3 * rms_b[3],
+      1e3 * rms_b[4], 1e3 * rms_f[2], 1e3 * rms_f[3], 1e3 * rms_f[4], fused.weight_a[0],
+      100.0 * double(within) / double(6 * n));
+  // Each of yaw, x and y within 1.6 times the better estimate's (covariance intersection gives
+  // up part of each one's information to stay consistent), and far better than the worse one's.
+  for (int i : {2, 3, 4}) {
+    EXPECT_LT(rms_f[i], 1.6 * std::min(rms_a[i], rms_b[i])) << "axis " << i;
+    EXPECT_LT(rms_f[i], 0.5 * std::max(rms_a[i], rms_b[i])) << "axis " << i;
+  }
+  EXPECT_GE(double(within) / double(6 * n), 0.99);
+  EXPECT_TRUE(fused.fused);
+  EXPECT_LT(fused.disagreeing_fraction, 0.02);
+  // a claiming a tenth of the noise it has: the covariances' test refuses the fusion.
+  gt::OdometryInput overconfident = a;
+  for (gt::Matrix6d& c : overconfident.step_covariance) c *= 0.01;
+  const gt::FusedMotions refused = gt::fuse_motions(overconfident, b);
+  EXPECT_FALSE(refused.fused);
+  EXPECT_GT(refused.disagreeing_fraction, 0.5);
+  EXPECT_LT(
+      (refused.motions.T_odom_lidar.T_world_body[n].t - b.T_odom_lidar.T_world_body[n].t).norm(),
+      1e-12);
+  // b better than a in every direction: b alone (its motions chained again: round-off only).
+  gt::OdometryInput worse = a;
+  for (gt::Matrix6d& c : worse.step_covariance) c = 100.0 * b.step_covariance[0];
+  const gt::FusedMotions b_alone = gt::fuse_motions(worse, b);
+  EXPECT_EQ(b_alone.weight_a[0], 0.0);
+  EXPECT_LT(
+      (b_alone.motions.T_odom_lidar.T_world_body[n].t - b.T_odom_lidar.T_world_body[n].t).norm(),
+      1e-7);
+  // Not the same poses: refused.
+  gt::OdometryInput shifted = b;
+  shifted.T_odom_lidar.stamps[3] = shifted.T_odom_lidar.stamps[3] + Time::from_seconds(0.01);
+  EXPECT_THROW(gt::fuse_motions(a, shifted), Error);
 }
 
 TEST(GroundTruthCli, WritesVbrsFormatAndSigmasRefusesBadInputAndSaysWhatIsUndetermined) {

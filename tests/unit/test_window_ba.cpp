@@ -15,6 +15,7 @@
 #include "rigcal/gt/plane_patches.h"
 #include "rigcal/gt/point_to_plane_error.h"
 #include "rigcal/gt/sequence_ba.h"
+#include "rigcal/gt/spherical_image.h"
 #include "rigcal/gt/sweep_point_to_plane_error.h"
 #include "rigcal/gt/window_ba.h"
 #include "rigcal/rig/rig_yaml.h"
@@ -109,6 +110,8 @@ SimWindow sim_window(sim::MotionKind motion, size_t n) {
       ScanPoint q;
       q.p = p.p;
       q.t_ns = p.t_ns;
+      q.intensity = p.intensity;
+      q.ring = p.ring;
       scan.points.push_back(q);
     }
     w.scans.push_back(std::move(scan));
@@ -318,6 +321,69 @@ TEST(WindowBa, AWalksRawSweepsAreDeskewedByTheAdjustment) {
   EXPECT_LT(max_of(r1), 0.08);
   EXPECT_LT(ba.rms_after_m, at_truth.rms_before_m + 0.001);
   EXPECT_LT(rms(t1), 0.5 * rms(t2)) << "the sweeps' motion should matter on a walk";
+}
+
+// A sweep's spherical image (the photometric term's): the projection found from the scan puts
+// every point on its own beam's row and the image holds a range at most pixels; a point moved
+// into another scan's image by the true knots finds its own range there.
+TEST(SphericalImage, PointsFallOnTheirBeamsRows) {
+  const SimWindow w = sim_window(sim::MotionKind::walk, 2);
+  const Scan& scan = w.scans[0];
+  const gt::SphericalProjection projection = gt::spherical_projection(scan);
+  ASSERT_EQ(projection.rows, 64);
+  EXPECT_NEAR(projection.cols, 1024, 8);
+  double worst = 0;
+  std::vector<Eigen::Vector3d> p;
+  std::vector<float> intensity;
+  for (const ScanPoint& q : scan.points) {
+    double u = 0, v = 0;
+    projection.project(Eigen::Vector3d(q.p.cast<double>()), &u, &v);
+    worst = std::max(worst, std::abs(v - double(q.ring)));
+    p.push_back(q.p.cast<double>());
+    intensity.push_back(q.intensity);
+  }
+  EXPECT_LT(worst, 0.1) << "rows off their beams";
+  const gt::SphericalImage image = gt::spherical_image(p, intensity, projection);
+  const size_t filled = size_t(
+      std::count_if(image.range_m.begin(), image.range_m.end(), [](double r) { return r > 0; }));
+  std::printf("[ figures ] a walk's sweep: %zu points, %d x %d image, %.1f %% of pixels filled\n",
+              scan.points.size(), projection.rows, projection.cols,
+              100.0 * double(filled) / double(image.range_m.size()));
+  EXPECT_GT(double(filled), 0.5 * double(image.range_m.size()));
+}
+
+// The photometric term on the twelve raw sweeps of a walk: after the geometric rounds, each
+// sweep's points against the images of the two sweeps before it. It must converge as the
+// geometric adjustment does (a tenth of the initial error, under 1 cm everywhere). What it
+// changes is printed: on this window (seed 12) the knots' positions 1.96 -> 1.47 mm rms, their
+// rotations 0.012 -> 0.031 deg: the range residuals at grazing incidence tilt the sweeps in roll
+// and pitch, and over a sequence that tilt is what makes the term worse than none
+// (doc/ground-truth.md, "The photometric term").
+TEST(WindowBa, ThePhotometricTermKeepsAWalksKnotsOnTheTruth) {
+  const size_t n = 12;
+  const SimWindow w = sim_window(sim::MotionKind::walk, n);
+  const std::vector<SE3> initial = perturbed(w.truth, 12);
+  gt::WindowBaConfig config;
+  const gt::WindowBaResult geometric = gt::window_ba(w.scans, initial, w.end, config);
+  config.photometric.enabled = true;
+  const gt::WindowBaResult both = gt::window_ba(w.scans, initial, w.end, config);
+  std::vector<double> t0, r0, t1, r1, t2, r2;
+  knot_errors(w.truth, initial, n + 1, t0, r0);
+  knot_errors(w.truth, geometric.T_world_lidar, n + 1, t1, r1);
+  knot_errors(w.truth, both.T_world_lidar, n + 1, t2, r2);
+  std::printf(
+      "[ figures ] knots before %.1f mm, %.3f deg rms; geometric %.2f mm (max %.2f), %.4f deg; "
+      "with the photometric term (%zu residuals, sigmas %.1f mm, %.1f intensity) %.2f mm (max "
+      "%.2f), %.4f deg\n",
+      1e3 * rms(t0), rms(r0), 1e3 * rms(t1), 1e3 * max_of(t1), rms(r1), both.photometric_residuals,
+      1e3 * both.photometric_sigma_range_m, both.photometric_sigma_intensity, 1e3 * rms(t2),
+      1e3 * max_of(t2), rms(r2));
+  EXPECT_GT(both.photometric_residuals, 1000u * (n - 1));
+  EXPECT_EQ(geometric.photometric_residuals, 0u);
+  EXPECT_LT(both.photometric_sigma_range_m, 0.05);
+  EXPECT_LT(rms(t2), 0.1 * rms(t0));
+  EXPECT_LT(max_of(t2), 0.01);
+  EXPECT_LT(rms(r2), 0.1 * rms(r0));
 }
 
 // The motion error e of `measured` against `truth` (measured = perturbed(truth, e)).
