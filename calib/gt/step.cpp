@@ -431,6 +431,15 @@ std::string ground_truth_summary(const GroundTruthRun& run, const nlohmann::json
         1e3 * b["point_plane_rms_before_m"]["median"].get<double>(),
         1e3 * b["point_plane_rms_after_m"]["median"].get<double>(),
         1e3 * b["pose_change_from_stage1_m"]["rms"].get<double>());
+    if (run.fused) {
+      const size_t steps = run.odometry_weight.size();
+      out += fmt::format(
+          "motions: the adjustment's fused with the odometry's (covariance intersection), the "
+          "odometry weighing more in {} of {} steps; {:.1f} % of the steps apart beyond the 99 % "
+          "quantile of their covariances\n",
+          b["fusion_with_odometry"]["steps_weighing_the_odometry_more"].get<size_t>(), steps,
+          100 * run.fusion_disagreeing_fraction);
+    }
   }
   if (run.map) {
     out += fmt::format("map: {} points in {} m voxels from {} scans\n", run.map->points.size(),
