@@ -69,10 +69,10 @@ TEST(GroundTruthSimLong, ADriveOfAMinuteWithA120mOutageThreeSeeds) {
 
 // What the photometric term adds (`--photometric`): three seeds each of the walk and the drive
 // through `rigcal ground-truth` without it and with it, the same recordings. It makes the ground
-// truth worse (walk seed 1: ATE 18.3 -> 27.1 mm, RPE over 10 m 2.4 -> 21.3 mm; doc/ground-truth.md,
-// "The photometric term"), so what is checked is that it runs through and stays honest (the
-// sigmas, which come from the GNSS and the motions' covariances, still cover the errors);
-// the figures are the measurement.
+// truth worse (RPE over 10 m: the walks 2.2-3.0 -> 14.8-21.3 mm, the drives 1.2-1.4 -> 2.7-3.1;
+// doc/ground-truth.md, "The photometric term"), so what is checked is that it runs through and
+// stays honest (the sigmas, which come from the GNSS and the motions' covariances, still cover
+// the errors); the figures are the measurement.
 TEST(GroundTruthSimLong, WhatThePhotometricTermAdds) {
   namespace fs = std::filesystem;
   for (const auto& [name, config] : {std::pair<std::string, std::string>{"walk", "{}\n"},
