@@ -64,53 +64,34 @@ void run(const Options& o) {
     in.markers = io::read_marker_survey(o.markers);
     in.markers_file = o.markers;
   }
-  const std::string sigmas =
+  gt::GroundTruthPaths paths;
+  paths.trajectory = o.out;
+  paths.sigmas =
       o.sigmas.empty() ? fs::path(o.out).replace_extension("").string() + "_sigmas.txt" : o.sigmas;
-  std::vector<io::OutputFile> files = {{o.out, ""}, {sigmas, ""}};
-  if (!o.report.empty()) files.push_back({o.report + "/ground_truth.json", ""});
-  if (!o.map.empty()) files.push_back({o.map, ""});
-  io::refuse_outputs_over_inputs(files, {{"gnss", in.gnss},
-                                         {"markers", in.markers_file},
-                                         {"odometry", in.odometry},
-                                         {"covariances", in.covariances},
-                                         {"scans", in.scans},
-                                         {"rig", o.rig}});
+  if (!o.report.empty()) paths.report = fs::path(o.report) / "ground_truth.json";
+  paths.map = o.map;
+  io::refuse_outputs_over_inputs(
+      {{paths.trajectory, ""}, {paths.sigmas, ""}, {paths.report, ""}, {paths.map, ""}},
+      {{"gnss", in.gnss},
+       {"markers", in.markers_file},
+       {"odometry", in.odometry},
+       {"covariances", in.covariances},
+       {"scans", in.scans},
+       {"rig", o.rig}});
 
   const gt::GroundTruthRun run = gt::run_ground_truth(in, options, console_progress());
   const gt::PoseGraphResult& g = run.graph;
   const nlohmann::json report = gt::ground_truth_report(run, in);
   fmt::print("{}", gt::ground_truth_summary(run, report));
-  if (!o.report.empty())
-    files[2].content = report.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
-  if (!o.map.empty()) {
-    if (run.map)
-      files.back().content = io::point_cloud_to_ply(run.map->points, run.map->intensity);
-    else
-      files.pop_back();
+  io::write_files_atomic(gt::ground_truth_files(run, report, paths));
+  for (const gt::Undetermined& u : g.undetermined)
+    fmt::print(stderr, "undetermined: {}: {}\n", u.what, u.why);
+  if (!g.T_enu_lidar.empty()) {
+    fmt::print("wrote {} (T_enu_lidar at each scan's stamp, VBR's ground-truth format){}{}\n",
+               o.out, g.covariance.empty() ? "" : ", " + paths.sigmas.string(),
+               o.report.empty() ? "" : "; report " + paths.report.string());
   }
-  auto say_undetermined = [&g] {
-    for (const gt::Undetermined& u : g.undetermined)
-      fmt::print(stderr, "undetermined: {}: {}\n", u.what, u.why);
-  };
-  if (g.T_enu_lidar.empty()) {
-    // Nothing placed: the report only.
-    say_undetermined();
-    if (!o.report.empty()) io::write_files_atomic({files[2]});  // the report only
-    throw Exit{3};
-  }
-  files[0].content = io::ground_truth_to_text(g.T_enu_lidar);
-  if (g.covariance.empty())
-    files.erase(files.begin() + 1);
-  else
-    files[1].content = io::pose_sigmas_to_text(g.T_enu_lidar, g.covariance);
-  io::write_files_atomic(files);
-  fmt::print("wrote {} (T_enu_lidar at each scan's stamp, VBR's ground-truth format){}{}\n", o.out,
-             g.covariance.empty() ? "" : ", " + sigmas,
-             o.report.empty() ? "" : fmt::format("; report {}/ground_truth.json", o.report));
-  if (!g.undetermined.empty()) {
-    say_undetermined();
-    throw Exit{3};
-  }
+  if (g.T_enu_lidar.empty() || !g.undetermined.empty()) throw Exit{3};
 }
 
 }  // namespace ground_truth_command

@@ -12,6 +12,7 @@
 #include "rigcal/core/error.h"
 #include "rigcal/core/text.h"
 #include "rigcal/core/version.h"
+#include "rigcal/io/ground_truth_io.h"
 #include "rigcal/io/trajectory_io.h"
 #include "rigcal/report/json.h"
 
@@ -462,6 +463,23 @@ std::filesystem::path default_gnss(const std::filesystem::path& recording) {
     if (fs::exists(recording / name)) return recording / name;
   throw Error(fmt::format("{}: no gnss/poses.tum, gnss/fixes.csv or gnss/navsat.csv; give --gnss",
                           recording.string()));
+}
+
+std::vector<io::OutputFile> ground_truth_files(const GroundTruthRun& run,
+                                               const nlohmann::json& report,
+                                               const GroundTruthPaths& paths) {
+  const PoseGraphResult& g = run.graph;
+  std::vector<io::OutputFile> files;
+  if (!g.T_enu_lidar.empty() && !paths.trajectory.empty())
+    files.push_back({paths.trajectory, io::ground_truth_to_text(g.T_enu_lidar)});
+  if (!g.T_enu_lidar.empty() && !g.covariance.empty() && !paths.sigmas.empty())
+    files.push_back({paths.sigmas, io::pose_sigmas_to_text(g.T_enu_lidar, g.covariance)});
+  if (!paths.report.empty())
+    files.push_back({paths.report,
+                     report.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"});
+  if (!paths.map.empty() && run.map)
+    files.push_back({paths.map, io::point_cloud_to_ply(run.map->points, run.map->intensity)});
+  return files;
 }
 
 }  // namespace rigcal::gt

@@ -16,6 +16,7 @@
 #include "rigcal/gt/motion_fusion.h"
 #include "rigcal/gt/pose_graph.h"
 #include "rigcal/gt/sequence_ba.h"
+#include "rigcal/io/files.h"
 #include "rigcal/io/gnss_fixes.h"
 #include "rigcal/lidar/step.h"
 #include "rigcal/report/step.h"
@@ -107,6 +108,17 @@ nlohmann::json ground_truth_report(const GroundTruthRun& run, const StepInputs& 
 // residuals, the fixes' correlation time, the poses' sigmas, the bundle adjustment, the map and
 // the markers, the notes (from the report, ground_truth_report).
 std::string ground_truth_summary(const GroundTruthRun& run, const nlohmann::json& report);
+
+// Where a run's files go (an empty path: not written).
+struct GroundTruthPaths {
+  std::filesystem::path trajectory, sigmas, report, map;  // report: the JSON file
+};
+// The files of a run, with their contents: the trajectory (VBR's format) and its sigmas (when the
+// pose graph placed the poses; the sigmas when it gave covariances), the report, the map (when it
+// was built).
+std::vector<io::OutputFile> ground_truth_files(const GroundTruthRun& run,
+                                               const nlohmann::json& report,
+                                               const GroundTruthPaths& paths);
 
 // The recording's GNSS file: gnss/poses.tum, gnss/fixes.csv or gnss/navsat.csv, the first there.
 // Throws rigcal::Error when none is.
