@@ -127,6 +127,27 @@ int threads(const WindowBaConfig& config) {
                             : int(std::max(1u, std::thread::hardware_concurrency()));
 }
 
+// Solves `problem` with the planes eliminated (Schur) and the knots solved; throws on failure,
+// naming the solve (`what`: "" or "photometric ").
+void solve_knots(ceres::Problem& problem, std::vector<Eigen::Vector4d>& plane, std::vector<Knot>& x,
+                 int iterations, const WindowBaConfig& config, const char* what) {
+  auto* ordering = new ceres::ParameterBlockOrdering;
+  for (Eigen::Vector4d& p : plane)
+    if (problem.HasParameterBlock(p.data())) ordering->AddElementToGroup(p.data(), 0);
+  for (Knot& k : x)
+    if (problem.HasParameterBlock(k.data())) ordering->AddElementToGroup(k.data(), 1);
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::DENSE_SCHUR;  // the planes eliminated, the poses solved
+  options.linear_solver_ordering.reset(ordering);
+  options.max_num_iterations = iterations;
+  options.num_threads = threads(config);
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  if (!summary.IsSolutionUsable())
+    throw Error(std::string("window bundle adjustment: the ") + what +
+                "solve failed: " + summary.message);
+}
+
 // The motion's covariance between consecutive scan knots (`scan_knots`, indices into the internal
 // knots): the information of the knots from the last solve's Jacobian, the planes eliminated
 // (each plane's 3 x 3 block, its Schur complement onto the knots it touches), inverted with the
@@ -393,7 +414,6 @@ WindowBaResult window_ba(const std::vector<Scan>& scans, const std::vector<SE3>&
     for (size_t j = 0; j < a.planes.size(); ++j) plane[j] << a.planes[j].normal, 0.0;
     last = std::make_unique<ceres::Problem>();
     ceres::Problem& problem = *last;
-    auto* ordering = new ceres::ParameterBlockOrdering;
     // One residual block a plane and knot: the points of one scan (or two, where a sweep's
     // knots meet) on one plane, measured from that knot on.
     std::map<std::pair<uint32_t, uint32_t>, std::vector<const SweepPoint*>> groups;
@@ -424,23 +444,14 @@ WindowBaResult window_ba(const std::vector<Scan>& scans, const std::vector<SE3>&
       problem.SetManifold(
           plane[j].data(),
           new ceres::ProductManifold<ceres::SphereManifold<3>, ceres::EuclideanManifold<1>>{});
-      ordering->AddElementToGroup(plane[j].data(), 0);
     }
     for (size_t k = 0; k < knots; ++k) {
       if (!problem.HasParameterBlock(x[k].data())) continue;
       problem.SetManifold(x[k].data(), new KnotManifold);
-      ordering->AddElementToGroup(x[k].data(), 1);
     }
     if (problem.HasParameterBlock(x[0].data())) problem.SetParameterBlockConstant(x[0].data());
-    ceres::Solver::Options options;
-    options.linear_solver_type = ceres::DENSE_SCHUR;  // the planes eliminated, the poses solved
-    options.linear_solver_ordering.reset(ordering);
-    options.max_num_iterations = out.rounds == 1 ? config.max_iterations : config.later_iterations;
-    options.num_threads = threads(config);
-    ceres::Solver::Summary summary;
-    ceres::Solve(options, &problem, &summary);
-    if (!summary.IsSolutionUsable())
-      throw Error("window bundle adjustment: the solve failed: " + summary.message);
+    solve_knots(problem, plane, x,
+                out.rounds == 1 ? config.max_iterations : config.later_iterations, config, "");
     double moved = 0;
     for (size_t k = 1; k < knots; ++k) {
       if (!problem.HasParameterBlock(x[k].data())) continue;
@@ -462,20 +473,7 @@ WindowBaResult window_ba(const std::vector<Scan>& scans, const std::vector<SE3>&
   if (photometric && last && projection.rows > 0) {
     add_photometric(*last, dense, points, x, T_world_knot, scan_knot, projection,
                     config.photometric, images, references, out);
-    auto* ordering = new ceres::ParameterBlockOrdering;
-    for (Eigen::Vector4d& p : plane)
-      if (last->HasParameterBlock(p.data())) ordering->AddElementToGroup(p.data(), 0);
-    for (size_t k = 0; k < knots; ++k)
-      if (last->HasParameterBlock(x[k].data())) ordering->AddElementToGroup(x[k].data(), 1);
-    ceres::Solver::Options options;
-    options.linear_solver_type = ceres::DENSE_SCHUR;
-    options.linear_solver_ordering.reset(ordering);
-    options.max_num_iterations = config.photometric.iterations;
-    options.num_threads = threads(config);
-    ceres::Solver::Summary summary;
-    ceres::Solve(options, last.get(), &summary);
-    if (!summary.IsSolutionUsable())
-      throw Error("window bundle adjustment: the photometric solve failed: " + summary.message);
+    solve_knots(*last, plane, x, config.photometric.iterations, config, "photometric ");
     for (size_t k = 1; k < knots; ++k)
       if (last->HasParameterBlock(x[k].data())) T_world_knot[k] = knot_pose(x[k]);
     for (size_t k = 0; k < scan_knot.size(); ++k) out.T_world_lidar[k] = T_world_knot[scan_knot[k]];
