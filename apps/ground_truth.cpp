@@ -28,6 +28,8 @@ struct Options {
   bool no_bundle_adjustment = false, photometric = false, no_fusion = false;
   size_t window_scans = gt::SequenceBaConfig{}.window_scans;
   size_t window_overlap = gt::SequenceBaConfig{}.overlap_scans;
+  std::pair<size_t, size_t> windows{0, 0};  // FROM:TO; TO 0: all
+  std::vector<std::string> window_motions;
 };
 
 void run(const Options& o) {
@@ -56,6 +58,14 @@ void run(const Options& o) {
   options.ba.window_scans = o.window_scans;
   options.ba.overlap_scans = o.window_overlap;
   options.ba.window.photometric.enabled = o.photometric;
+  if (o.windows.second > 0) {
+    if (o.windows.first >= o.windows.second)
+      throw Error(
+          fmt::format("--windows {}:{}: FROM must be below TO", o.windows.first, o.windows.second));
+    options.ba.first_window = o.windows.first;
+    options.ba.end_window = o.windows.second;
+  }
+  for (const std::string& f : o.window_motions) in.window_motions.push_back(f);
   options.fuse_odometry = !o.no_fusion;
   options.map = !o.map.empty();
   options.map_config.voxel_size_m = o.map_voxel_m;
@@ -83,7 +93,12 @@ void run(const Options& o) {
   const gt::PoseGraphResult& g = run.graph;
   const nlohmann::json report = gt::ground_truth_report(run, in);
   fmt::print("{}", gt::ground_truth_summary(run, report));
-  io::write_files_atomic(gt::ground_truth_files(run, report, paths));
+  const std::vector<io::OutputFile> files = gt::ground_truth_files(run, report, paths);
+  io::write_files_atomic(files);
+  if (run.chunk_motions) {
+    for (const io::OutputFile& f : files) fmt::print("wrote {}\n", f.path.string());
+    return;
+  }
   for (const gt::Undetermined& u : g.undetermined)
     fmt::print(stderr, "undetermined: {}: {}\n", u.what, u.why);
   if (!g.T_enu_lidar.empty()) {
@@ -111,7 +126,9 @@ void add_ground_truth(CLI::App& app) {
       "pose graph, solved again with the same priors. With --map or --markers, the scans\n"
       "placed by the result: the map, and the survey markers found in it as clusters of\n"
       "bright points, their distances against the survey's. Exit 3 when the fixes leave\n"
-      "something undetermined (said on stderr). The photometric term is not built.");
+      "something undetermined (said on stderr). A job array (doc/performance.md): each task\n"
+      "runs --windows FROM:TO (OUT: its motions), then one run joins them with\n"
+      "--window-motions.");
   cmd->add_option("recording", o->recording,
                   "the recording: its gnss/ (poses.tum, fixes.csv or navsat.csv) and its scans "
                   "(ouster_points/, a capture, a session): the odometry's without --odometry, "
@@ -162,6 +179,15 @@ void add_ground_truth(CLI::App& app) {
                   "scans each window shares with the previous one")
       ->check(CLI::Range(size_t(0), size_t(999)))
       ->capture_default_str();
+  cmd->add_option("--windows", o->windows,
+                  "FROM:TO: adjust only the windows FROM to TO - 1 (numbered from 0) and write "
+                  "the motions they own to OUT (TUM) and OUT's _covariances.txt, nothing else: "
+                  "one task of a job array (the same odometry, GNSS and options in every task)")
+      ->delimiter(':');
+  cmd->add_option("--window-motions", o->window_motions,
+                  "the motions the tasks of --windows wrote (all of them, any order): joined in "
+                  "place of the bundle adjustment, then the pose graph as usual")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--map", o->map,
                   "output map: the scans placed by the ground truth, one point a voxel (binary "
                   "PLY: x y z intensity, the ENU frame)");

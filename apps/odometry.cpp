@@ -29,9 +29,7 @@ void run(const Options& o) {
   config.deskew = !o.no_deskew;
   config.estimate_sweep_motion = o.sweep_motion;
   const std::string covariances =
-      o.covariances.empty()
-          ? (std::filesystem::path(o.out).replace_extension("").string() + "_covariances.txt")
-          : o.covariances;
+      o.covariances.empty() ? io::step_covariances_beside(o.out).string() : o.covariances;
   std::vector<io::OutputFile> files = {{o.out, ""}, {covariances, ""}};
   if (!o.report.empty()) files.push_back({o.report + "/odometry.json", ""});
   const std::filesystem::path scans = lidar::scans_folder(o.recording, console_progress());

@@ -7,6 +7,7 @@
 // odometry's. The windows are independent of each other, so the cost grows linearly with the
 // sequence and the memory holds one window of scans.
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -24,6 +25,11 @@ struct SequenceBaConfig {
   size_t overlap_scans = 4;  // each window starts this many scans before the previous one ends
   // Windows adjusted at once (each on one thread; the scans of all of them held); 0: one a core.
   int parallel_windows = 0;
+  // Only the windows [first_window, end_window) of the sequence's plan (a chunk of a job array,
+  // doc/performance.md): the motions they own come from them, the others stay the odometry's
+  // (SequenceBaResult::from_window says which); join_window_motions puts the chunks together.
+  // The plan, and so each window, is the whole sequence's whatever the chunk.
+  size_t first_window = 0, end_window = std::numeric_limits<size_t>::max();
 };
 
 // One window as it was adjusted (WindowBaResult's figures).
@@ -46,7 +52,12 @@ struct SequenceBaResult {
   OdometryInput motions;
   std::vector<WindowSummary> windows;
   size_t motions_from_odometry = 0;  // of the windows that gave no covariance
-  size_t scans_unused = 0;           // read, but stamped at no pose of the trajectory
+  // Per motion: true where an adjusted window gave it.
+  std::vector<bool> from_window;
+  // The windows the sequence's plan has, and the motions [first_owned, end_owned) the adjusted
+  // windows own (all of them without a chunk).
+  size_t planned_windows = 0, first_owned = 0, end_owned = 0;
+  size_t scans_unused = 0;  // read, but stamped at no pose of the trajectory
   double seconds = 0;
 };
 
@@ -57,5 +68,25 @@ struct SequenceBaResult {
 SequenceBaResult sequence_ba(const std::function<std::optional<Scan>()>& next_scan,
                              const Trajectory& T_world_lidar, const OdometryInput& odometry,
                              const SequenceBaConfig& config, const report::Progress& progress = {});
+
+// The first pose (scan) of window `window` of the plan of a sequence of `poses` (none past the
+// plan's end): where a chunk's scans start (what came before may be skipped unread).
+std::optional<size_t> first_pose_of_window(size_t poses, const SequenceBaConfig& config,
+                                           size_t window);
+
+// The motions a chunk's windows own (first_owned..end_owned), chained from the pose of
+// `T_world_lidar` (the poses the windows started from) at the first of them, with their
+// covariances: what a task of a job array writes. Empty when the chunk owns none.
+OdometryInput owned_motions(const SequenceBaResult& ba, const Trajectory& T_world_lidar);
+
+// The motions of the chunks of a job array (each chunk's owned motions, SequenceBaResult with
+// first_owned..end_owned, chained as poses with their step covariances; `sources` name them in
+// errors) put in the sequence's place: every chunk's consecutive poses must be consecutive poses
+// of `odometry` (throws rigcal::Error naming the chunk otherwise, or where two chunks give the
+// same motion); the motions no chunk gives stay the odometry's (motions_from_odometry). The
+// result is chained from `T_world_first` as sequence_ba's.
+SequenceBaResult join_window_motions(const std::vector<OdometryInput>& chunks,
+                                     const std::vector<std::string>& sources,
+                                     const OdometryInput& odometry, const SE3& T_world_first);
 
 }  // namespace rigcal::gt

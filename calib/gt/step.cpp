@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <unordered_map>
 
 #include "rigcal/bench/metrics.h"
@@ -13,6 +14,7 @@
 #include "rigcal/core/text.h"
 #include "rigcal/core/version.h"
 #include "rigcal/io/ground_truth_io.h"
+#include "rigcal/io/odometry_io.h"
 #include "rigcal/io/trajectory_io.h"
 #include "rigcal/report/json.h"
 
@@ -49,6 +51,29 @@ std::vector<Matrix6d> covariances_of_steps(const Trajectory& T_odom_lidar,
   return out;
 }
 
+namespace {
+
+// A trajectory and its step covariances (`covariances`, or beside it), as the pose graph takes
+// motions. `what_to_do` ends the error when the covariances are missing.
+OdometryInput read_motions(const fs::path& trajectory, const fs::path& covariances_given,
+                           const std::string& what_to_do) {
+  const fs::path covariances =
+      covariances_given.empty() ? io::step_covariances_beside(trajectory) : covariances_given;
+  if (!fs::exists(covariances)) {
+    throw Error(fmt::format(
+        "{}: no step covariances (looked for {}): the pose graph weighs each step by its "
+        "covariance; {}",
+        trajectory.string(), covariances.string(), what_to_do));
+  }
+  OdometryInput motions;
+  motions.T_odom_lidar = io::read_trajectory(trajectory).trajectory;
+  motions.step_covariance = covariances_of_steps(
+      motions.T_odom_lidar, io::read_step_covariances(covariances), covariances.string());
+  return motions;
+}
+
+}  // namespace
+
 GroundTruthRun run_ground_truth(const StepInputs& in, const StepOptions& o,
                                 const report::Progress& progress) {
   const auto started = std::chrono::steady_clock::now();
@@ -64,22 +89,16 @@ GroundTruthRun run_ground_truth(const StepInputs& in, const StepOptions& o,
   run.p_lidar_antenna = (lidar->T_base_sensor.inverse() * gnss->T_base_sensor).t;
 
   // The odometry: a file and its covariances, or rigcal's run.
+  const bool chunk = o.ba.first_window > 0 || o.ba.end_window != std::numeric_limits<size_t>::max();
+  if (chunk && (!in.window_motions.empty() || !o.bundle_adjustment || in.scans.empty()))
+    throw Error(
+        "a chunk of windows is a piece of the bundle adjustment: it needs the scans, and neither "
+        "chunks' motions to join nor --no-bundle-adjustment");
   OdometryInput odometry;
   if (!in.odometry.empty()) {
-    const fs::path covariances =
-        in.covariances.empty()
-            ? fs::path(fs::path(in.odometry).replace_extension("").string() + "_covariances.txt")
-            : in.covariances;
-    if (!fs::exists(covariances)) {
-      throw Error(fmt::format(
-          "{}: no step covariances (looked for {}): the pose graph weighs each step by its "
-          "covariance; give --covariances, or let rigcal's odometry run on the scans",
-          in.odometry.string(), covariances.string()));
-    }
     report::tell(progress, "reading the odometry", 0, 1);
-    odometry.T_odom_lidar = io::read_trajectory(in.odometry).trajectory;
-    odometry.step_covariance = covariances_of_steps(
-        odometry.T_odom_lidar, io::read_step_covariances(covariances), covariances.string());
+    odometry = read_motions(in.odometry, in.covariances,
+                            "give --covariances, or let rigcal's odometry run on the scans");
     report::tell(progress, "reading the odometry", 1, 1);
   } else {
     if (in.scans.empty()) throw Error("no odometry and no scans: give one of them");
@@ -148,15 +167,44 @@ GroundTruthRun run_ground_truth(const StepInputs& in, const StepOptions& o,
   // Stage 2: the windows start from the graph's poses; their motions, in a graph again.
   if (!o.bundle_adjustment) {
     run.notes.push_back("bundle adjustment not asked for: the trajectory is the pose graph's");
+  } else if (run.graph.T_enu_lidar.size() != odometry.T_odom_lidar.size()) {
+    if (chunk) throw Error("the pose graph placed no poses: no windows to adjust");
+    run.notes.push_back("the pose graph placed no poses: no bundle adjustment");
+  } else if (!in.window_motions.empty()) {
+    std::vector<OdometryInput> chunks;
+    std::vector<std::string> sources;
+    for (size_t c = 0; c < in.window_motions.size(); ++c) {
+      report::tell(progress, "reading the chunks' motions", c, in.window_motions.size());
+      chunks.push_back(
+          read_motions(in.window_motions[c], {}, "a chunk writes them beside its motions"));
+      sources.push_back(in.window_motions[c].string());
+    }
+    run.ba = join_window_motions(chunks, sources, odometry, run.graph.T_enu_lidar.T_world_body[0]);
+    run.ba->config = o.ba;
+    if (run.ba->motions_from_odometry > 0) {
+      run.notes.push_back(fmt::format(
+          "bundle adjustment: {} of {} motions in none of the {} chunks given: the odometry's "
+          "kept (a chunk missing?)",
+          run.ba->motions_from_odometry, run.ba->motions.step_covariance.size(), chunks.size()));
+    }
   } else if (in.scans.empty()) {
     run.notes.push_back(
         "no scans given or found: no bundle adjustment, the trajectory is the pose graph's");
-  } else if (run.graph.T_enu_lidar.size() != odometry.T_odom_lidar.size()) {
-    run.notes.push_back("the pose graph placed no poses: no bundle adjustment");
   } else {
     lidar::ScanStream stream(in.scans);
+    if (const std::optional<size_t> first =
+            first_pose_of_window(odometry.T_odom_lidar.size(), o.ba, o.ba.first_window);
+        chunk && first) {
+      stream.skip_before(odometry.T_odom_lidar.stamps[*first]);
+    }
     run.ba =
         sequence_ba([&] { return stream.next(); }, run.graph.T_enu_lidar, odometry, o.ba, progress);
+    if (chunk) {
+      run.chunk_motions = owned_motions(*run.ba, run.graph.T_enu_lidar);
+      run.seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+      return run;
+    }
     if (run.ba->motions_from_odometry > 0) {
       run.notes.push_back(fmt::format(
           "bundle adjustment: {} of {} motions kept from the odometry (their windows' information "
@@ -168,6 +216,9 @@ GroundTruthRun run_ground_truth(const StepInputs& in, const StepOptions& o,
           fmt::format("bundle adjustment: {} scans stamped at no pose of the odometry, not used",
                       run.ba->scans_unused));
     }
+  }
+  // The adjusted motions (a whole run's, or the chunks' joined) in the pose graph again.
+  if (run.ba) {
     report::tell(progress, "solving the pose graph of the adjusted motions", 0, 1);
     run.stage1 = std::move(run.graph);
     if (o.fuse_odometry) {
@@ -321,7 +372,24 @@ nlohmann::json ground_truth_report(const GroundTruthRun& run, const StepInputs& 
                               {"pose_change_from_stage1_m", stats(moved_m)},
                               {"rotation_change_from_stage1_deg", stats(turned_deg)},
                               {"seconds", ba.seconds},
+                              {"planned_windows", ba.planned_windows},
                               {"per_window", std::move(windows)}};
+    if (run.chunk_motions) {
+      const Trajectory& T = run.chunk_motions->T_odom_lidar;
+      j["bundle_adjustment"]["chunk"] = {
+          {"first_window", ba.config.first_window},
+          {"end_window", ba.config.end_window},
+          {"motions", run.chunk_motions->step_covariance.size()},
+          {"from_s",
+           T.empty() ? nlohmann::json() : nlohmann::json(to_seconds_text(T.stamps.front()))},
+          {"to_s",
+           T.empty() ? nlohmann::json() : nlohmann::json(to_seconds_text(T.stamps.back()))}};
+    }
+    if (!in.window_motions.empty()) {
+      nlohmann::json files = nlohmann::json::array();
+      for (const fs::path& p : in.window_motions) files.push_back(p.string());
+      j["bundle_adjustment"]["joined_chunks"] = std::move(files);
+    }
     if (!run.odometry_weight.empty()) {
       const size_t odometry_first =
           size_t(std::count_if(run.odometry_weight.begin(), run.odometry_weight.end(),
@@ -422,7 +490,29 @@ std::string ground_truth_summary(const GroundTruthRun& run, const nlohmann::json
         1e3 * s["pose_sigma_horizontal_m"]["max"].get<double>(),
         s["pose_sigma_yaw_deg"]["median"].get<double>());
   }
-  if (run.ba) {
+  if (run.chunk_motions) {
+    const nlohmann::json& chunk = report["bundle_adjustment"]["chunk"];
+    const size_t first = chunk["first_window"], planned = run.ba->planned_windows;
+    const size_t end = std::min(chunk["end_window"].get<size_t>(), planned);
+    if (run.chunk_motions->step_covariance.empty()) {
+      out += fmt::format(
+          "bundle adjustment, a chunk: the plan has {} windows (numbered from 0), none in "
+          "{}:{} (nothing written)\n",
+          planned, first, chunk["end_window"].get<size_t>());
+    } else {
+      out += fmt::format(
+          "bundle adjustment, a chunk: windows {}..{} of the plan's {} (numbered from 0) in "
+          "{:.1f} s; they own the {} motions from {} s to {} s\n",
+          first, end - 1, planned, run.ba->seconds, run.chunk_motions->step_covariance.size(),
+          chunk["from_s"].get<std::string>(), chunk["to_s"].get<std::string>());
+    }
+  } else if (run.ba && run.ba->windows.empty()) {
+    out += fmt::format(
+        "bundle adjustment: the motions of {} chunks joined, {} of {} motions from them\n",
+        report["bundle_adjustment"]["joined_chunks"].size(),
+        run.ba->motions.step_covariance.size() - run.ba->motions_from_odometry,
+        run.ba->motions.step_covariance.size());
+  } else if (run.ba) {
     const nlohmann::json& b = report["bundle_adjustment"];
     out += fmt::format(
         "bundle adjustment: {} windows in {:.1f} s; points off their planes rms {:.1f} mm before, "
@@ -432,15 +522,16 @@ std::string ground_truth_summary(const GroundTruthRun& run, const nlohmann::json
         1e3 * b["point_plane_rms_before_m"]["median"].get<double>(),
         1e3 * b["point_plane_rms_after_m"]["median"].get<double>(),
         1e3 * b["pose_change_from_stage1_m"]["rms"].get<double>());
-    if (run.fused) {
-      const size_t steps = run.odometry_weight.size();
-      out += fmt::format(
-          "motions: the adjustment's fused with the odometry's (covariance intersection), the "
-          "odometry weighing more in {} of {} steps; {:.1f} % of the steps apart beyond the 99 % "
-          "quantile of their covariances\n",
-          b["fusion_with_odometry"]["steps_weighing_the_odometry_more"].get<size_t>(), steps,
-          100 * run.fusion_disagreeing_fraction);
-    }
+  }
+  if (run.fused) {
+    const nlohmann::json& b = report["bundle_adjustment"];
+    const size_t steps = run.odometry_weight.size();
+    out += fmt::format(
+        "motions: the adjustment's fused with the odometry's (covariance intersection), the "
+        "odometry weighing more in {} of {} steps; {:.1f} % of the steps apart beyond the 99 % "
+        "quantile of their covariances\n",
+        b["fusion_with_odometry"]["steps_weighing_the_odometry_more"].get<size_t>(), steps,
+        100 * run.fusion_disagreeing_fraction);
   }
   if (run.map) {
     out += fmt::format("map: {} points in {} m voxels from {} scans\n", run.map->points.size(),
@@ -470,13 +561,25 @@ std::vector<io::OutputFile> ground_truth_files(const GroundTruthRun& run,
                                                const GroundTruthPaths& paths) {
   const PoseGraphResult& g = run.graph;
   std::vector<io::OutputFile> files;
+  if (!paths.report.empty())
+    files.push_back({paths.report,
+                     report.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"});
+  if (run.chunk_motions) {
+    const Trajectory& T = run.chunk_motions->T_odom_lidar;
+    if (!T.empty() && !paths.trajectory.empty()) {
+      std::vector<io::StepCovariance> steps;
+      for (size_t k = 0; k + 1 < T.size(); ++k)
+        steps.push_back({T.stamps[k], T.stamps[k + 1], run.chunk_motions->step_covariance[k]});
+      files.push_back({paths.trajectory, io::trajectory_to_tum(T)});
+      files.push_back(
+          {io::step_covariances_beside(paths.trajectory), io::step_covariances_to_text(steps)});
+    }
+    return files;
+  }
   if (!g.T_enu_lidar.empty() && !paths.trajectory.empty())
     files.push_back({paths.trajectory, io::ground_truth_to_text(g.T_enu_lidar)});
   if (!g.T_enu_lidar.empty() && !g.covariance.empty() && !paths.sigmas.empty())
     files.push_back({paths.sigmas, io::pose_sigmas_to_text(g.T_enu_lidar, g.covariance)});
-  if (!paths.report.empty())
-    files.push_back({paths.report,
-                     report.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"});
   if (!paths.map.empty() && run.map)
     files.push_back({paths.map, io::point_cloud_to_ply(run.map->points, run.map->intensity)});
   return files;

@@ -56,6 +56,11 @@ struct StepInputs {
   std::filesystem::path gnss;
   rig::Rig rig;  // the lever arm (the GNSS sensor's T_b) and its clock (time_offset)
   std::string rig_source;
+  // The motions of a job array's chunks of windows (each a trajectory and its step covariances
+  // beside it, io::step_covariances_beside: what a run with StepOptions::ba's first_window and
+  // end_window writes), joined in place of the bundle adjustment (join_window_motions): the
+  // scans are then not read, unless for the map.
+  std::vector<std::filesystem::path> window_motions;
   // Survey markers to check the map against (markers.h; io::read_marker_survey), and their file.
   std::optional<MarkerSurvey> markers;
   std::filesystem::path markers_file;
@@ -78,6 +83,10 @@ struct GroundTruthRun {
   std::optional<lidar::OdometryRun> odometry;  // when rigcal's ran here
   std::optional<LidarMap> map;                 // when asked, from the scans
   std::optional<MarkerCheck> markers;          // when a survey was given
+  // A chunk of windows (StepOptions::ba's first_window, end_window): the motions its windows own,
+  // chained from stage 1's pose at the first of them, with their covariances; the run stops
+  // there (graph is stage 1's; no fusion, no map).
+  std::optional<OdometryInput> chunk_motions;
   std::string odometry_preset;
   // The fixes' error correlation time the last solve used, s: the configuration's, or
   // estimated (PoseGraphConfig::fix_correlation_s < 0 asks for that).
@@ -115,7 +124,8 @@ struct GroundTruthPaths {
 };
 // The files of a run, with their contents: the trajectory (VBR's format) and its sigmas (when the
 // pose graph placed the poses; the sigmas when it gave covariances), the report, the map (when it
-// was built).
+// was built). A chunk of windows: its motions (TUM) at `trajectory` and their step covariances
+// beside it (io::step_covariances_beside), the report; nothing when it owns no motion.
 std::vector<io::OutputFile> ground_truth_files(const GroundTruthRun& run,
                                                const nlohmann::json& report,
                                                const GroundTruthPaths& paths);

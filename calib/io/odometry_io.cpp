@@ -10,6 +10,10 @@
 
 namespace rigcal::io {
 
+std::filesystem::path step_covariances_beside(const std::filesystem::path& trajectory) {
+  return std::filesystem::path(trajectory).replace_extension("").string() + "_covariances.txt";
+}
+
 std::string step_covariances_to_text(const std::vector<StepCovariance>& steps) {
   std::string out =
       "# rigcal odometry: covariance of each step T_prev_cur (doc/odometry.md)\n"

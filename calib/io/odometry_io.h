@@ -19,6 +19,9 @@ struct StepCovariance {
 };
 
 std::string step_covariances_to_text(const std::vector<StepCovariance>& steps);
+// Where a trajectory's step covariances go and are looked for by default: the trajectory's path
+// without its extension, + "_covariances.txt" (what `rigcal odometry` writes beside OUT).
+std::filesystem::path step_covariances_beside(const std::filesystem::path& trajectory);
 // Throws rigcal::Error naming the file and line on bad input (a count other than 23, a number
 // not read, a matrix not symmetric positive semi-definite on its diagonal).
 std::vector<StepCovariance> read_step_covariances(const std::filesystem::path& path);

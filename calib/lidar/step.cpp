@@ -150,6 +150,13 @@ std::optional<Scan> ScanStream::next() {
   return scan;
 }
 
+size_t ScanStream::skip_before(Time stamp) {
+  if (impl_->capture || impl_->bag) return 0;
+  const size_t from = read_;
+  while (read_ < impl_->folder.stamps.size() && impl_->folder.stamps[read_] < stamp) ++read_;
+  return read_ - from;
+}
+
 size_t ScanStream::total() const {
   if (impl_->bag) return impl_->bag->total();
   return impl_->capture ? 0 : impl_->folder.files.size();

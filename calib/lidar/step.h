@@ -40,6 +40,10 @@ class ScanStream {
   ScanStream(const ScanStream&) = delete;
   ScanStream& operator=(const ScanStream&) = delete;
   std::optional<Scan> next();
+  // Moves past the scans stamped before `stamp` without reading them, where the source allows it
+  // (a folder: its stamps are known before its files are read); a capture or bags are not moved
+  // (their scans are then read through by next()). Returns how many were skipped.
+  size_t skip_before(Time stamp);
   size_t read() const { return read_; }
   size_t total() const;        // of a folder or bags; 0 for a capture (not known before the end)
   std::string source() const;  // the file of the last scan read, or the capture

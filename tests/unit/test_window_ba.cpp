@@ -468,6 +468,59 @@ TEST(SequenceBa, AWalksWindowsGiveMotionsBetterThanTheOdometrysWithHonestSigmas)
   EXPECT_LT(rms(ba_t), 0.3 * rms(odo_t));
   EXPECT_LT(rms(ba_r), 0.3 * rms(odo_r));
   EXPECT_GE(double(within), 0.95 * double(components));
+
+  // A job array: the same plan cut into chunks of windows (the last one past the plan's end),
+  // each adjusted alone from its first window's scan on (those before skipped unread, as
+  // lidar::ScanStream::skip_before does for a folder), their owned motions joined, gives the
+  // whole run's motions and covariances (to rounding: the chunks' motions are chained and taken
+  // apart again).
+  ASSERT_EQ(ba.planned_windows, 5u);  // 30 scans, windows of 8 starting every 6
+  std::vector<gt::OdometryInput> chunks;
+  size_t owned = 0;
+  for (const auto& [first, end] : std::vector<std::pair<size_t, size_t>>{{0, 2}, {2, 3}, {3, 9}}) {
+    gt::SequenceBaConfig chunk_config = config;
+    chunk_config.first_window = first;
+    chunk_config.end_window = end;
+    next = gt::first_pose_of_window(n + 1, config, first).value();
+    EXPECT_EQ(next, 6 * first);
+    const gt::SequenceBaResult chunk =
+        gt::sequence_ba(next_scan, odometry.T_odom_lidar, odometry, chunk_config);
+    EXPECT_EQ(chunk.windows.size(), std::min<size_t>(end, 5) - first);
+    chunks.push_back(gt::owned_motions(chunk, odometry.T_odom_lidar));
+    owned += chunks.back().step_covariance.size();
+  }
+  EXPECT_EQ(owned, n);
+  const gt::SequenceBaResult joined = gt::join_window_motions(
+      chunks, {"a", "b", "c"}, odometry, odometry.T_odom_lidar.T_world_body[0]);
+  EXPECT_EQ(joined.motions_from_odometry, 0u);
+  ASSERT_EQ(joined.motions.T_odom_lidar.size(), n + 1);
+  double worst_t = 0, worst_r = 0, worst_c = 0;
+  for (size_t k = 0; k < n; ++k) {
+    const auto& A = ba.motions.T_odom_lidar.T_world_body;
+    const auto& B = joined.motions.T_odom_lidar.T_world_body;
+    const SE3 d = (A[k].inverse() * A[k + 1]).inverse() * (B[k].inverse() * B[k + 1]);
+    worst_t = std::max(worst_t, d.t.norm());
+    worst_r = std::max(worst_r, rotation_angle(d.R));
+    worst_c = std::max(
+        worst_c,
+        (joined.motions.step_covariance[k] - ba.motions.step_covariance[k]).cwiseAbs().maxCoeff() /
+            ba.motions.step_covariance[k].cwiseAbs().maxCoeff());
+  }
+  std::printf("[ figures ] chunks joined against the whole run: %.2g m, %.2g rad, %.2g relative\n",
+              worst_t, worst_r, worst_c);
+  EXPECT_LT(worst_t, 1e-12);
+  EXPECT_LT(worst_r, 1e-12);
+  EXPECT_LT(worst_c, 1e-12);
+  // Chunks that overlap, or that belong to another trajectory, are refused.
+  EXPECT_THROW(gt::join_window_motions({chunks[0], chunks[0]}, {"a", "a2"}, odometry, SE3()),
+               Error);
+  gt::OdometryInput shifted = chunks[1];
+  for (Time& t : shifted.T_odom_lidar.stamps) t = t + Time::from_seconds(0.05);
+  EXPECT_THROW(gt::join_window_motions({shifted}, {"shifted"}, odometry, SE3()), Error);
+  // A chunk missing: its motions stay the odometry's, counted.
+  EXPECT_EQ(gt::join_window_motions({chunks[0], chunks[2]}, {"a", "c"}, odometry, SE3())
+                .motions_from_odometry,
+            chunks[1].step_covariance.size());
 }
 
 }  // namespace
