@@ -22,7 +22,7 @@ namespace fs = std::filesystem;
 struct Options {
   std::string recording, rig, out, sigmas, odometry, covariances, gnss, report, scans, map, markers;
   double map_voxel_m = gt::MapConfig{}.voxel_size_m, marker_intensity = 0;
-  std::string gnss_sensor = "gnss", odometry_preset;
+  std::string gnss_sensor = "gnss", odometry_preset, enu_origin;
   double max_fix_gap_s = 0.5;
   std::string fix_correlation = "auto";
   bool no_bundle_adjustment = false, photometric = false, no_fusion = false;
@@ -50,6 +50,8 @@ void run(const Options& o) {
   if (!o.odometry.empty()) in.odometry = o.odometry, in.covariances = o.covariances;
   gt::StepOptions options;
   options.gnss_sensor = o.gnss_sensor;
+  if (!o.enu_origin.empty())
+    options.enu_origin = io::parse_geodetic_origin(o.enu_origin, "--enu-origin");
   options.odometry_preset = o.odometry_preset;
   options.pose_graph.max_fix_gap_s = o.max_fix_gap_s;
   options.pose_graph.fix_correlation_s =
@@ -119,11 +121,12 @@ void add_ground_truth(CLI::App& app) {
       "The LiDAR's ground-truth trajectory (doc/ground-truth.md): a pose graph over the scan\n"
       "poses with the odometry's steps weighted by their covariances and the GNSS fixes as\n"
       "position priors through the lever arm (robust solve, a chi-square gate, a second\n"
-      "solve). Writes OUT (VBR's <seq>_gt.txt: T_enu_lidar, ENU at the first fix) and each\n"
-      "pose's sigmas. Then, when the scans are there, the geometric LiDAR bundle adjustment:\n"
-      "overlapping windows of scans, each sweep deskewed by the motion it estimates, the\n"
-      "points brought onto planar patches; the windows' motions replace the odometry's in the\n"
-      "pose graph, solved again with the same priors. With --map or --markers, the scans\n"
+      "solve). Writes OUT (VBR's <seq>_gt.txt: T_enu_lidar, ENU at the first fix or at\n"
+      "--enu-origin) and each pose's sigmas. Then, when the scans are there, the geometric\n"
+      "LiDAR bundle adjustment: overlapping windows of scans, each sweep deskewed by the\n"
+      "motion it estimates, the points brought onto planar patches; the windows' motions\n"
+      "replace the odometry's in the pose graph, solved again with the same priors. With\n"
+      "--map or --markers, the scans\n"
       "placed by the result: the map, and the survey markers found in it as clusters of\n"
       "bright points, their distances against the survey's. Exit 3 when the fixes leave\n"
       "something undetermined (said on stderr). A job array (doc/performance.md): each task\n"
@@ -146,6 +149,10 @@ void add_ground_truth(CLI::App& app) {
                   "its step covariances (default: ODOMETRY without extension + _covariances.txt)");
   cmd->add_option("--gnss", o->gnss, "GNSS/INS poses (TUM, T_enu_gnss) or fixes (CSV)");
   cmd->add_option("--gnss-sensor", o->gnss_sensor, "the rig's GNSS sensor")->capture_default_str();
+  cmd->add_option("--enu-origin", o->enu_origin,
+                  "LAT,LON,HEIGHT (degrees, degrees, ellipsoidal m): the fixes' ENU frame at this "
+                  "origin instead of at the first fix (sessions that must share one frame; fixes "
+                  "only, not GNSS/INS poses)");
   cmd->add_option("--odometry-preset", o->odometry_preset,
                   "rigcal's odometry preset (default: the rig LiDAR's model)")
       ->check(CLI::IsMember(lidar::preset_names()));

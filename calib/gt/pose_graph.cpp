@@ -254,12 +254,15 @@ std::string_view to_string(FixQuality quality) {
 std::vector<PositionFix> position_fixes(const Trajectory& T_enu_gnss,
                                         const std::vector<Eigen::Vector3d>& std_enu_m,
                                         const std::vector<int>& status, double time_offset_s,
-                                        const PoseGraphConfig& config) {
+                                        const PoseGraphConfig& config,
+                                        const std::vector<FixQuality>& quality) {
   if (!std_enu_m.empty() && std_enu_m.size() != T_enu_gnss.size())
     throw Error(
         fmt::format("{} standard deviations for {} fixes", std_enu_m.size(), T_enu_gnss.size()));
   if (!status.empty() && status.size() != T_enu_gnss.size())
     throw Error(fmt::format("{} fix states for {} fixes", status.size(), T_enu_gnss.size()));
+  if (!quality.empty() && quality.size() != T_enu_gnss.size())
+    throw Error(fmt::format("{} fix types for {} fixes", quality.size(), T_enu_gnss.size()));
   std::vector<PositionFix> out;
   out.reserve(T_enu_gnss.size());
   const Time offset = Time::from_seconds(time_offset_s);
@@ -268,14 +271,19 @@ std::vector<PositionFix> position_fixes(const Trajectory& T_enu_gnss,
     PositionFix f;
     f.stamp = T_enu_gnss.stamps[i] + offset;
     f.p_enu = T_enu_gnss.T_world_body[i].t;
-    f.quality = status.empty() || status[i] == 2 ? FixQuality::rtk_fixed : FixQuality::single;
+    // NavSatFix's status cannot tell RTK float from fixed: the solution's type, when given.
+    if (!quality.empty())
+      f.quality = quality[i];
+    else
+      f.quality = status.empty() || status[i] == 2 ? FixQuality::rtk_fixed : FixQuality::single;
     // A receiver that does not know its accuracy reports zeros (NavSatFix's covariance type
     // unknown): its state's sigmas then.
     if (!std_enu_m.empty() && std_enu_m[i].minCoeff() > 0) {
       f.covariance = std_enu_m[i].cwiseProduct(std_enu_m[i]).asDiagonal();
     } else {
-      f.covariance = covariance_of(f.quality == FixQuality::rtk_fixed ? config.sigma_rtk_fixed
-                                                                      : config.sigma_single);
+      f.covariance = covariance_of(f.quality == FixQuality::rtk_fixed   ? config.sigma_rtk_fixed
+                                   : f.quality == FixQuality::rtk_float ? config.sigma_rtk_float
+                                                                        : config.sigma_single);
     }
     out.push_back(f);
   }

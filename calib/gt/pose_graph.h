@@ -40,14 +40,17 @@ struct PoseGraphConfig {
 };
 
 // Fixes from a GNSS/INS trajectory (its positions: the antenna or the INS frame's origin, ENU)
-// on its own clock: stamps moved to the base clock by `time_offset_s`; covariances from the
-// receiver's standard deviations (`std_enu_m`, one a fix, or empty; zeros: not known) or else from
-// the fix's quality (`status`, NavSatFix's, one a fix or empty: 2 RTK fixed, 0 and 1 single, -1 no
-// fix, left out), `rtk_fixed` when neither is given.
+// on its own clock: stamps moved to the base clock by `time_offset_s`. Each fix's quality: from
+// `quality` (the solution's type, one a fix, or empty) when given, else from `status`
+// (NavSatFix's, one a fix or empty: 2 RTK fixed, 0 and 1 single), else rtk_fixed; a fix whose
+// status is -1 (no fix) is left out whatever its quality. Its covariance: from the receiver's
+// standard deviations (`std_enu_m`, one a fix, or empty; zeros: not known) when given, else
+// the quality's sigmas (config.sigma_rtk_fixed, sigma_rtk_float, sigma_single).
 std::vector<PositionFix> position_fixes(const Trajectory& T_enu_gnss,
                                         const std::vector<Eigen::Vector3d>& std_enu_m,
                                         const std::vector<int>& status, double time_offset_s,
-                                        const PoseGraphConfig& config);
+                                        const PoseGraphConfig& config,
+                                        const std::vector<FixQuality>& quality = {});
 
 // The scan poses in the fixes' ENU frame. `p_lidar_antenna`: the antenna (the fixes' point) in
 // the LiDAR frame. Nothing throws on data that fix too little: the result says what is

@@ -118,17 +118,30 @@ GroundTruthRun run_ground_truth(const StepInputs& in, const StepOptions& o,
   // The fixes: positions, on the base clock.
   report::tell(progress, "reading the GNSS", 0, 1);
   if (io::is_gnss_fixes_file(in.gnss)) {
-    const io::GnssFixes f = io::read_gnss_fixes(in.gnss, std::nullopt);
+    const io::GnssFixes f = io::read_gnss_fixes(in.gnss, std::nullopt, o.enu_origin);
     run.origin = f.origin;
+    std::vector<FixQuality> quality;
+    for (const io::FixType t : f.fix_type) {
+      quality.push_back(t == io::FixType::rtk_fixed   ? FixQuality::rtk_fixed
+                        : t == io::FixType::rtk_float ? FixQuality::rtk_float
+                                                      : FixQuality::single);
+    }
     run.fixes = position_fixes(on_base_clock(f.T_enu_gnss, *gnss), f.std_enu_m, f.status, 0.0,
-                               o.pose_graph);
+                               o.pose_graph, quality);
     if (f.std_enu_m.empty()) {
       run.notes.push_back(fmt::format(
           "{} gives no standard deviations: every fix taken as {} (horizontal {} m, vertical {} m)",
-          in.gnss.string(), f.status.empty() ? "RTK fixed" : "its status says",
+          in.gnss.string(),
+          f.fix_type.empty() && f.status.empty() ? "RTK fixed" : "its fix type or status says",
           o.pose_graph.sigma_rtk_fixed.x(), o.pose_graph.sigma_rtk_fixed.y()));
     }
   } else {
+    if (o.enu_origin) {
+      throw Error(fmt::format(
+          "{}: an ENU origin applies to fixes (a CSV of latitude, longitude, height); GNSS/INS "
+          "poses are already in their own ENU frame",
+          in.gnss.string()));
+    }
     const Trajectory T_enu_gnss = io::read_trajectory(in.gnss).trajectory;
     run.fixes = position_fixes(on_base_clock(T_enu_gnss, *gnss), {}, {}, 0.0, o.pose_graph);
     run.notes.push_back(fmt::format(

@@ -26,6 +26,9 @@ namespace rigcal::gt {
 
 struct StepOptions {
   std::string gnss_sensor = "gnss", lidar_sensor = "lidar";  // the rig's sensors
+  // The ENU frame of fixes (a CSV) at this origin instead of at the first fix: sessions that
+  // must share one frame. GNSS/INS poses, already in their ENU frame, refuse it.
+  std::optional<io::GeodeticOrigin> enu_origin;
   PoseGraphConfig pose_graph;
   // rigcal's odometry, when it runs on StepInputs::scans (lidar::choose_preset).
   std::string odometry_preset;

@@ -39,6 +39,7 @@ enum Column {
   kStdN,
   kStdU,
   kStatus,
+  kFixType,
   kColumns
 };
 const std::array<std::vector<std::string_view>, kColumns> kAliases = {{
@@ -53,9 +54,62 @@ const std::array<std::vector<std::string_view>, kColumns> kAliases = {{
     {"std_north", "sigma_north"},
     {"std_up", "sigma_up"},
     {"status"},
+    {"fix_type", "q", "quality"},
 }};
 
+// RTKLIB's Q codes, or the words.
+std::optional<FixType> fix_type_of(std::string_view field) {
+  const std::string name = lower(field);
+  if (name == "1" || name == "fixed" || name == "fix" || name == "rtk_fixed")
+    return FixType::rtk_fixed;
+  if (name == "2" || name == "6" || name == "float" || name == "rtk_float")
+    return FixType::rtk_float;
+  if (name == "5" || name == "3" || name == "4" || name == "single") return FixType::single;
+  return std::nullopt;
+}
+
 }  // namespace
+
+std::string_view to_string(FixType type) {
+  switch (type) {
+    case FixType::rtk_fixed:
+      return "fixed";
+    case FixType::rtk_float:
+      return "float";
+    case FixType::single:
+      return "single";
+  }
+  return "?";
+}
+
+GeodeticOrigin parse_geodetic_origin(std::string_view text, std::string_view what) {
+  std::vector<std::string_view> f;
+  size_t from = 0;
+  for (;;) {
+    const size_t comma = text.find(',', from);
+    f.push_back(trim(text.substr(from, comma == std::string_view::npos ? comma : comma - from)));
+    if (comma == std::string_view::npos) break;
+    from = comma + 1;
+  }
+  const std::string expected = fmt::format(
+      "{}: expected LAT,LON,HEIGHT (degrees, degrees, ellipsoidal m), got '{}'", what, text);
+  if (f.size() != 3) throw Error(expected);
+  GeodeticOrigin o;
+  try {
+    o.latitude_deg = parse_double(f[0], "latitude");
+    o.longitude_deg = parse_double(f[1], "longitude");
+    o.height_m = parse_double(f[2], "height");
+  } catch (const Error&) {
+    throw Error(expected);
+  }
+  if (std::abs(o.latitude_deg) > 90 || std::abs(o.longitude_deg) > 180 ||
+      !(o.height_m >= -12000 && o.height_m <= 100000)) {
+    throw Error(fmt::format(
+        "{}: latitude {} / longitude {} / height {} m outside +-90 / +-180 / -12 km..100 km", what,
+        o.latitude_deg, o.longitude_deg, o.height_m));
+  }
+  return o;
+}
 
 Attitude attitude_from_string(std::string_view name) {
   if (name == "enu") return Attitude::enu;
@@ -200,6 +254,21 @@ GnssFixes parse_gnss_fixes(std::string_view text, std::string_view file_name,
       }
       out.status.push_back(static_cast<int>(status));
     }
+    if (col[kFixType] >= 0) {
+      const int i = col[kFixType];
+      if (i >= static_cast<int>(f.size())) {
+        fail_at(file_name, number, "",
+                fmt::format("{} fields, no 'fix_type' (column {})", f.size(), i + 1));
+      }
+      const std::optional<FixType> type = fix_type_of(f[i]);
+      if (!type) {
+        fail_at(file_name, number, "",
+                fmt::format("column {} (fix_type): expected RTKLIB's Q (1 fixed, 2 float, 3 "
+                            "SBAS, 4 DGPS, 5 single, 6 PPP) or fixed, float, single; got '{}'",
+                            i + 1, f[i]));
+      }
+      out.fix_type.push_back(*type);
+    }
   }
   if (!std_h.empty()) out.median_horizontal_std_m = median(std_h);
   if (!std_v.empty()) out.median_vertical_std_m = median(std_v);
@@ -209,6 +278,28 @@ GnssFixes parse_gnss_fixes(std::string_view text, std::string_view file_name,
 GnssFixes read_gnss_fixes(const std::filesystem::path& path, std::optional<Attitude> attitude,
                           const std::optional<GeodeticOrigin>& origin) {
   return parse_gnss_fixes(read_text_file(path), path.string(), attitude, origin);
+}
+
+std::string gnss_fixes_csv(const Trajectory& T_enu_gnss,
+                           const std::vector<Eigen::Vector3d>& std_enu_m,
+                           const std::vector<FixType>& fix_type, const GeodeticOrigin& origin) {
+  if (std_enu_m.size() != T_enu_gnss.size() || fix_type.size() != T_enu_gnss.size()) {
+    throw Error(fmt::format("{} fixes with {} standard deviations and {} fix types",
+                            T_enu_gnss.size(), std_enu_m.size(), fix_type.size()));
+  }
+  const GeographicLib::LocalCartesian enu(origin.latitude_deg, origin.longitude_deg,
+                                          origin.height_m);
+  std::string out = "time,latitude,longitude,height,std_east,std_north,std_up,status,fix_type\n";
+  for (size_t i = 0; i < T_enu_gnss.size(); ++i) {
+    const Eigen::Vector3d& p = T_enu_gnss.T_world_body[i].t;
+    double lat = 0, lon = 0, h = 0;
+    enu.Reverse(p.x(), p.y(), p.z(), lat, lon, h);
+    const Eigen::Vector3d& s = std_enu_m[i];
+    out += fmt::format("{},{:.10f},{:.10f},{:.4f},{:.4f},{:.4f},{:.4f},{},{}\n",
+                       to_seconds_text(T_enu_gnss.stamps[i]), lat, lon, h, s.x(), s.y(), s.z(),
+                       fix_type[i] == FixType::single ? 0 : 2, to_string(fix_type[i]));
+  }
+  return out;
 }
 
 }  // namespace rigcal::io

@@ -11,6 +11,7 @@
 #include "rigcal/core/text.h"
 #include "rigcal/core/version.h"
 #include "rigcal/io/files.h"
+#include "rigcal/io/gnss_fixes.h"
 #include "rigcal/io/target_yaml.h"
 #include "rigcal/io/trajectory_io.h"
 #include "rigcal/report/json.h"
@@ -220,17 +221,34 @@ void write_imu(const fs::path& dir, const sim::ImuPart& part, nlohmann::json& tr
 
 void write_trajectories(const fs::path& dir, const sim::TrajectoryPart& part,
                         nlohmann::json& truth) {
+  std::vector<FixType> fix_type;
+  for (const sim::FixState s : part.gnss_states) {
+    fix_type.push_back(s == sim::FixState::rtk_fixed   ? FixType::rtk_fixed
+                       : s == sim::FixState::rtk_float ? FixType::rtk_float
+                                                       : FixType::single);
+  }
+  const sim::GeodeticPoint& o = part.enu_origin;
   write_files_atomic(
       {{dir / "trajectories" / "truth_lidar.tum", trajectory_to_tum(part.truth_base)},
        {dir / "trajectories" / "lidar_odometry.tum", trajectory_to_tum(part.odometry)},
-       {dir / "trajectories" / "gnss_ins.tum", trajectory_to_tum(part.gnss)}});
+       {dir / "trajectories" / "gnss_ins.tum", trajectory_to_tum(part.gnss)},
+       {dir / "trajectories" / "gnss_fixes.csv",
+        gnss_fixes_csv(part.gnss, part.gnss_std_enu_m, fix_type,
+                       {o.latitude_deg, o.longitude_deg, o.height_m})}});
   nlohmann::json& j = truth["trajectories"];
   j["gnss_sensor"] = part.gnss_name;
   j["T_enu_world"] = report::pose_json(part.T_enu_world);
+  j["enu_origin"] = {{"latitude_deg", o.latitude_deg},
+                     {"longitude_deg", o.longitude_deg},
+                     {"height_m", o.height_m}};
   j["gnss_outlier_indices"] = part.gnss_outliers;
-  j["files"] = {{"truth_lidar.tum", "T_world_lidar, the truth, LiDAR rate"},
-                {"lidar_odometry.tum", "T_odom_lidar, drifting odometry"},
-                {"gnss_ins.tum", "T_enu_gnss on the GNSS clock, with noise, outages, outliers"}};
+  j["files"] = {
+      {"truth_lidar.tum", "T_world_lidar, the truth, LiDAR rate"},
+      {"lidar_odometry.tum", "T_odom_lidar, drifting odometry"},
+      {"gnss_ins.tum", "T_enu_gnss on the GNSS clock, with noise, outages, outliers"},
+      {"gnss_fixes.csv",
+       "gnss_ins.tum's positions as fixes (latitude, longitude, height at enu_origin's ENU "
+       "frame), with their states' sigmas and fix types"}};
 }
 
 void write_trajectory_scans(const fs::path& dir, sim::SweepDrive& drive, size_t count,

@@ -11,6 +11,8 @@
 //   {trans_sigma_m,
 //                  rot_sigma_deg, scale_error}, gnss: {rate_hz, horizontal_sigma_m,
 //                  vertical_sigma_m, rot_sigma_deg, outages: [[from, to], ...],
+//                  float_fixes, single_fixes: [[from, to], ...], float_horizontal_sigma_m,
+//                  float_vertical_sigma_m, single_horizontal_sigma_m, single_vertical_sigma_m,
 //                  outlier_probability, outlier_jump_m}}
 //   scans: {count}
 // Unknown keys are errors naming the line.

@@ -185,7 +185,11 @@ TrajectoryPart simulate_trajectories(const rig::Rig& rig, const SimConfig& cfg,
   noise.time_offset_s = gnss->time_offset;
   if (gnss->update_rate) noise.rate_hz = *gnss->update_rate;
   part.gnss = simulate_gnss(source, duration, start, gnss->T_base_sensor, part.T_enu_world, noise,
-                            rng, &part.gnss_outliers);
+                            rng, &part.gnss_outliers, &part.gnss_states);
+  for (const FixState state : part.gnss_states) {
+    const auto [h, v] = fix_sigmas(noise, state);
+    part.gnss_std_enu_m.emplace_back(h, h, v);
+  }
   return part;
 }
 
@@ -401,6 +405,10 @@ void ground_truth_defaults(SimConfig& c) {
   c.gnss.vertical_sigma_m = 0.02;
   c.gnss.correlation_time_s = 5.0;
   c.gnss.outages = {{20.0, 35.0}};
+  // Float fixes for 4 s on each side of the outage (the sky closing in near the building), and
+  // 2 s of single fixes later on.
+  c.gnss.float_spans = {{16.0, 20.0}, {35.0, 39.0}};
+  c.gnss.single_spans = {{48.0, 50.0}};
 }
 
 ScanPart simulate_scans(const rig::Rig& rig, const SimConfig& cfg) {

@@ -85,13 +85,24 @@ struct ImuPart {
   double imu_offset_s = 0, os_imu_offset_s = 0, imu_drift_ppm = 0, os_imu_drift_ppm = 0;
 };
 
+// A point on the WGS84 ellipsoid: latitude, longitude (deg), ellipsoidal height (m).
+struct GeodeticPoint {
+  double latitude_deg = 0, longitude_deg = 0, height_m = 0;
+};
+
 struct TrajectoryPart {
   Trajectory truth_base;  // T_world_lidar at the LiDAR rate
   double rate_hz = 10.0;  // truth_base's: the base sensor's update rate
   Trajectory odometry;    // T_odom_lidar
   Trajectory gnss;        // T_enu_gnss on the GNSS clock
   std::vector<size_t> gnss_outliers;
+  std::vector<FixState> gnss_states;  // one a pose of `gnss`
+  // The standard deviations of each pose's position error (east, north, up; m): its state's.
+  std::vector<Eigen::Vector3d> gnss_std_enu_m;
   SE3 T_enu_world;
+  // The ENU frame's origin, for the fixes as latitude, longitude and height: by the Colosseum in
+  // Rome, about 21 m above the sea, the geoid there some 48 m above the ellipsoid.
+  GeodeticPoint enu_origin{41.890210, 12.492231, 69.0};
   std::string gnss_name;
   // T_world_base at motion time (s); truth_base samples it. A replay's refers to the replayed
   // trajectory.
@@ -138,7 +149,8 @@ Sweep next_sweep(SweepDrive& drive);
 // What `rigcal simulate --what ground-truth` starts from (a config file then changes it): a
 // 60 s walk with the LiDAR's sweeps (64 beams over 90 deg, 1024 columns: a quarter of an
 // OS0-128's points, a few hundred MB), 6 survey markers, RTK noise of 1 cm horizontal and 2 cm
-// vertical correlated over 5 s, and a 15 s outage.
+// vertical correlated over 5 s, a 15 s outage with 4 s of float fixes on each side, and 2 s of
+// single fixes.
 void ground_truth_defaults(SimConfig& config);
 
 StereoPart simulate_stereo(const rig::Rig& rig, const SimConfig& config);

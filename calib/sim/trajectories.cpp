@@ -62,9 +62,33 @@ Trajectory simulate_odometry(const Trajectory& truth, const OdometryNoise& noise
   return out;
 }
 
+FixState fix_state_at(const GnssNoise& noise, double t) {
+  auto within = [t](const std::vector<std::pair<double, double>>& spans) {
+    for (const auto& [from, to] : spans)
+      if (t >= from && t < to) return true;
+    return false;
+  };
+  if (within(noise.single_spans)) return FixState::single;
+  if (within(noise.float_spans)) return FixState::rtk_float;
+  return FixState::rtk_fixed;
+}
+
+std::pair<double, double> fix_sigmas(const GnssNoise& noise, FixState state) {
+  switch (state) {
+    case FixState::rtk_float:
+      return {noise.float_horizontal_sigma_m, noise.float_vertical_sigma_m};
+    case FixState::single:
+      return {noise.single_horizontal_sigma_m, noise.single_vertical_sigma_m};
+    case FixState::rtk_fixed:
+      break;
+  }
+  return {noise.horizontal_sigma_m, noise.vertical_sigma_m};
+}
+
 Trajectory simulate_gnss(const PoseSource& source, double duration, Time base_start,
                          const SE3& T_base_gnss, const SE3& T_enu_world, const GnssNoise& noise,
-                         std::mt19937_64& rng, std::vector<size_t>* outliers) {
+                         std::mt19937_64& rng, std::vector<size_t>* outliers,
+                         std::vector<FixState>* states) {
   std::normal_distribution<double> N(0.0, 1.0);
   std::uniform_real_distribution<double> U(0.0, 1.0);
   Trajectory out;
@@ -91,9 +115,9 @@ Trajectory simulate_gnss(const PoseSource& source, double duration, Time base_st
     const Eigen::Vector3d jump(N(rng), N(rng), 0.3 * N(rng));
     if (outage) continue;
     SE3 T_enu_gnss = T_enu_world * source(t) * T_base_gnss;
-    T_enu_gnss.t +=
-        Eigen::Vector3d(noise.horizontal_sigma_m * n3.x(), noise.horizontal_sigma_m * n3.y(),
-                        noise.vertical_sigma_m * n3.z());
+    const FixState state = fix_state_at(noise, t);
+    const auto [sigma_h, sigma_v] = fix_sigmas(noise, state);
+    T_enu_gnss.t += Eigen::Vector3d(sigma_h * n3.x(), sigma_h * n3.y(), sigma_v * n3.z());
     T_enu_gnss.R = T_enu_gnss.R * rotation_from_vector(noise.rot_sigma_deg * M_PI / 180.0 * r3);
     if (outlier) {
       T_enu_gnss.t += noise.outlier_jump_m * jump.normalized() * (0.5 + U(rng));
@@ -101,6 +125,7 @@ Trajectory simulate_gnss(const PoseSource& source, double duration, Time base_st
     }
     out.stamps.push_back(Time::from_seconds(stamp));
     out.T_world_body.push_back(T_enu_gnss);
+    if (states) states->push_back(state);
   }
   return out;
 }

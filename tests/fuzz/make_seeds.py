@@ -66,6 +66,11 @@ seed("gnss_fixes", "fixes.csv", "time,lat,lon,height,roll,pitch,yaw,std_east,std
     for k in range(5)))
 seed("gnss_fixes", "iso_stamps.csv", "timestamp,latitude,longitude,altitude,roll,pitch,heading\n"
      "2024-03-20T10:00:00.000Z,41.9,12.5,40,0,0,90\n2024-03-20T10:00:00.100Z,41.9000001,12.5,40,0,0,91\n")
+seed("gnss_fixes", "fix_types.csv", "time,latitude,longitude,height,std_east,std_north,std_up,status,fix_type\n"
+     "1000.000000000,41.8902100000,12.4922310000,69.0000,0.0100,0.0100,0.0200,2,fixed\n"
+     "1000.010000000,41.8902100900,12.4922310000,69.0010,0.2000,0.2000,0.4000,2,float\n"
+     "1000.020000000,41.8902101800,12.4922310000,69.0020,1.5000,1.5000,3.0000,0,single\n")
+seed("gnss_fixes", "rtklib_q.csv", "time,lat,lon,height,Q\n1,41.9,12.5,50,1\n2,41.9,12.5,50,2\n3,41.9,12.5,50,5\n")
 
 seed("marker_survey", "positions.csv", "# a total station\nid,x,y,z\nM1,7.5692,-2.1187,-0.9299\n"
      "M2 15.4002 -4.4094 -0.2299\nM3,26.7303,-4.1680,0.4701\n")

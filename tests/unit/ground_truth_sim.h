@@ -1,6 +1,7 @@
 #pragma once
 // A simulated ground-truth recording (`rigcal simulate --what ground-truth`) through
-// `rigcal ground-truth --markers --map`, scored against the simulator's truth: the trajectory in
+// `rigcal ground-truth --markers --map` (its fixes CSV, with their states and sigmas, at the
+// simulator's ENU origin), scored against the simulator's truth: the trajectory in
 // the ENU frame without any alignment (the ground truth's whole error, its anchoring by the
 // fixes included), its sigmas' honesty, and the markers' distances.
 #include <fmt/format.h>
@@ -96,6 +97,13 @@ inline GroundTruthScore simulated_ground_truth(const std::filesystem::path& dir,
   s.sim_seconds = sim.seconds;
   if (failed(sim)) return s;
   const fs::path rec = dir / "rec";
+  const nlohmann::json truth_json = nlohmann::json::parse(slurp(rec / "truth.json"));
+  // The fixes with their states and sigmas, in the simulator's ENU frame (its origin).
+  const nlohmann::json& origin = truth_json["trajectories"]["enu_origin"];
+  const std::string gnss_input =
+      fmt::format("--gnss {}/trajectories/gnss_fixes.csv --enu-origin {},{},{}", rec.string(),
+                  origin["latitude_deg"].get<double>(), origin["longitude_deg"].get<double>(),
+                  origin["height_m"].get<double>());
   std::string args = gt_args;
   if (stages) {
     // rigcal's odometry once, for every stage.
@@ -112,24 +120,24 @@ inline GroundTruthScore simulated_ground_truth(const std::filesystem::path& dir,
     }
     std::ofstream(dir / "exact.tum") << io::trajectory_to_tum(truth);
     std::ofstream(dir / "exact_covariances.txt") << io::step_covariances_to_text(exact);
-    const CliRun bound = rigcal_cli(
-        fmt::format("ground-truth {0} --rig {0}/truth.yaml --gnss {0}/trajectories/gnss_ins.tum "
-                    "--out {1}/exact_gt.txt --odometry {1}/exact.tum --no-bundle-adjustment {2}",
-                    rec.string(), dir.string(), gt_args),
-        dir);
+    const CliRun bound =
+        rigcal_cli(fmt::format("ground-truth {0} --rig {0}/truth.yaml {3} --out {1}/exact_gt.txt "
+                               "--odometry {1}/exact.tum --no-bundle-adjustment {2}",
+                               rec.string(), dir.string(), gt_args, gnss_input),
+                   dir);
     if (failed(bound)) return s;
-    const CliRun stage1 = rigcal_cli(
-        fmt::format("ground-truth {0} --rig {0}/truth.yaml --gnss {0}/trajectories/gnss_ins.tum "
-                    "--out {1}/stage1.txt --odometry {1}/odometry.tum --no-bundle-adjustment",
-                    rec.string(), dir.string()),
-        dir);
+    const CliRun stage1 =
+        rigcal_cli(fmt::format("ground-truth {0} --rig {0}/truth.yaml {2} --out {1}/stage1.txt "
+                               "--odometry {1}/odometry.tum --no-bundle-adjustment",
+                               rec.string(), dir.string(), gnss_input),
+                   dir);
     if (failed(stage1)) return s;
   }
   const CliRun run = rigcal_cli(
-      fmt::format("ground-truth {0} --rig {0}/truth.yaml --gnss {0}/trajectories/gnss_ins.tum "
+      fmt::format("ground-truth {0} --rig {0}/truth.yaml {3} "
                   "--markers {0}/trajectories/markers.csv --out {1}/gt.txt --report {1}/report "
                   "--map {1}/map.ply {2}",
-                  rec.string(), dir.string(), args),
+                  rec.string(), dir.string(), args, gnss_input),
       dir);
   s.status = run.status;
   s.out = run.out;
@@ -137,10 +145,9 @@ inline GroundTruthScore simulated_ground_truth(const std::filesystem::path& dir,
   s.gt_seconds = run.seconds;
   if (run.status != 0) return s;
   s.report = nlohmann::json::parse(slurp(dir / "report/ground_truth.json"));
-  const nlohmann::json truth = nlohmann::json::parse(slurp(rec / "truth.json"));
   Eigen::Matrix4d m;
   for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) m(r, c) = truth["trajectories"]["T_enu_world"][r][c];
+    for (int c = 0; c < 4; ++c) m(r, c) = truth_json["trajectories"]["T_enu_world"][r][c];
   SE3 T_enu_world;
   T_enu_world.R = m.topLeftCorner<3, 3>();
   T_enu_world.t = m.topRightCorner<3, 1>();
@@ -186,7 +193,7 @@ inline GroundTruthScore simulated_ground_truth(const std::filesystem::path& dir,
     // Its multipath outliers left out (the simulator flags them): the GNSS at its best.
     const Trajectory T_enu_gnss = io::read_trajectory(rec / "trajectories/gnss_ins.tum").trajectory;
     std::vector<bool> outlier(T_enu_gnss.size(), false);
-    for (const nlohmann::json& i : truth["trajectories"]["gnss_outlier_indices"])
+    for (const nlohmann::json& i : truth_json["trajectories"]["gnss_outlier_indices"])
       outlier[i.get<size_t>()] = true;
     Trajectory T_enu_lidar;
     for (size_t k = 0; k < T_enu_gnss.size(); ++k) {

@@ -440,6 +440,24 @@ TEST(PoseGraph, PositionFixesTakeTheReceiversSigmasItsStatesAndTheClockOffset) {
   EXPECT_NEAR(u[0].covariance(0, 0), 0.01 * 0.01, 1e-15);
   EXPECT_THROW(gt::position_fixes(T_enu_gnss, {sd[0]}, {}, 0.0, config), Error);
   EXPECT_THROW(gt::position_fixes(T_enu_gnss, {}, {2, 2}, 0.0, config), Error);
+  // The solution's type wins over the status (which cannot tell RTK float from fixed); a fix
+  // the status calls no fix stays out; the receiver's sigmas still win over the type's.
+  using Q = gt::FixQuality;
+  const std::vector<Q> types = {Q::rtk_float, Q::single, Q::rtk_fixed, Q::rtk_fixed};
+  const std::vector<gt::PositionFix> q =
+      gt::position_fixes(T_enu_gnss, {}, {2, 2, -1, 0}, 0.0, config, types);
+  ASSERT_EQ(q.size(), 3u);
+  EXPECT_EQ(q[0].quality, Q::rtk_float);
+  EXPECT_EQ(q[1].quality, Q::single);
+  EXPECT_EQ(q[2].quality, Q::rtk_fixed);
+  EXPECT_NEAR(std::sqrt(q[0].covariance(0, 0)), config.sigma_rtk_float.x(), 1e-12);
+  EXPECT_NEAR(std::sqrt(q[0].covariance(2, 2)), config.sigma_rtk_float.y(), 1e-12);
+  EXPECT_NEAR(std::sqrt(q[1].covariance(2, 2)), config.sigma_single.y(), 1e-12);
+  const std::vector<gt::PositionFix> qs =
+      gt::position_fixes(T_enu_gnss, unknown, {}, 0.0, config, types);
+  EXPECT_NEAR(qs[0].covariance(0, 0), 0.01 * 0.01, 1e-15);  // its sigmas, not float's
+  EXPECT_NEAR(std::sqrt(qs[1].covariance(0, 0)), config.sigma_single.x(), 1e-12);  // zeros
+  EXPECT_THROW(gt::position_fixes(T_enu_gnss, {}, {}, 0.0, config, {Q::single}), Error);
 }
 
 // The fixes CSV read for positions (the ground truth's reading): no attitude columns needed, the
@@ -474,6 +492,62 @@ TEST(GnssFixesCsv, PositionsOnlyNeedNoAttitudeAndKeepSigmasAndStatus) {
           .find("standard deviations"),
       std::string::npos);
   EXPECT_NE(message("time,latitude,height\n1,41.9,5\n").find("'longitude'"), std::string::npos);
+}
+
+// The solution's type (fix_type, q or quality): RTKLIB's Q codes or words; anything else refused
+// with its line. The writer's fixes read back to the same ENU positions at the same origin.
+TEST(GnssFixesCsv, FixTypesReadAsCodesOrWordsAndTheWrittenFixesReadBack) {
+  using T = io::FixType;
+  const io::GnssFixes f = io::parse_gnss_fixes(
+      "time,latitude,longitude,height,Q\n1,41.9,12.5,50,1\n2,41.9,12.5,50,2\n3,41.9,12.5,50,5\n"
+      "4,41.9,12.5,50,3\n5,41.9,12.5,50,4\n6,41.9,12.5,50,6\n7,41.9,12.5,50,Float\n"
+      "8,41.9,12.5,50,fixed\n9,41.9,12.5,50,single\n",
+      "f.csv", std::nullopt);
+  EXPECT_EQ(f.fix_type, (std::vector<T>{T::rtk_fixed, T::rtk_float, T::single, T::single, T::single,
+                                        T::rtk_float, T::rtk_float, T::rtk_fixed, T::single}));
+  EXPECT_TRUE(f.status.empty());
+  for (const std::string bad : {"0", "7", "rtk", ""}) {
+    try {
+      io::parse_gnss_fixes(
+          "time,lat,lon,height,fix_type\n1,41.9,12.5,50,1\n2,41.9,12.5,50," + bad + "\n", "f.csv",
+          std::nullopt);
+      ADD_FAILURE() << "accepted fix type '" << bad << "'";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("f.csv:3"), std::string::npos) << e.what();
+    }
+  }
+  // The origin: three numbers within their ranges.
+  const io::GeodeticOrigin o = io::parse_geodetic_origin(" 41.89021, 12.492231,69", "--enu-origin");
+  EXPECT_DOUBLE_EQ(o.latitude_deg, 41.89021);
+  EXPECT_DOUBLE_EQ(o.longitude_deg, 12.492231);
+  EXPECT_DOUBLE_EQ(o.height_m, 69.0);
+  for (const char* bad :
+       {"41.9,12.5", "41.9,12.5,50,1", "91,12.5,50", "41.9,x,50", "41.9,12.5,1e6"})
+    EXPECT_THROW(io::parse_geodetic_origin(bad, "--enu-origin"), Error) << bad;
+  // Written and read back at the same origin: the positions within 0.1 mm, everything else kept.
+  Trajectory T_enu_gnss;
+  std::vector<Eigen::Vector3d> sd;
+  std::vector<T> types;
+  for (int i = 0; i < 5; ++i) {
+    T_enu_gnss.stamps.push_back(Time::from_seconds(1000.0 + 0.01 * i));
+    T_enu_gnss.T_world_body.push_back(SE3::from_rotation_vector(
+        Eigen::Vector3d::Zero(), Eigen::Vector3d(300.0 * i, -80.0 * i, 3.0 * i)));
+    sd.emplace_back(0.01 * (i + 1), 0.01 * (i + 1), 0.02 * (i + 1));
+    types.push_back(i < 2 ? T::rtk_fixed : i < 4 ? T::rtk_float : T::single);
+  }
+  const std::string csv = io::gnss_fixes_csv(T_enu_gnss, sd, types, o);
+  const io::GnssFixes back = io::parse_gnss_fixes(csv, "w.csv", std::nullopt, o);
+  ASSERT_EQ(back.T_enu_gnss.size(), 5u);
+  for (size_t i = 0; i < 5; ++i) {
+    EXPECT_EQ(back.T_enu_gnss.stamps[i], T_enu_gnss.stamps[i]);
+    EXPECT_LT((back.T_enu_gnss.T_world_body[i].t - T_enu_gnss.T_world_body[i].t).norm(), 1e-4);
+    EXPECT_LT((back.std_enu_m[i] - sd[i]).norm(), 1e-9);
+  }
+  EXPECT_EQ(back.fix_type, types);
+  EXPECT_EQ(back.status, (std::vector<int>{2, 2, 2, 2, 0}));
+  // At the first fix instead: the first position at the origin.
+  EXPECT_LT(io::parse_gnss_fixes(csv, "w.csv", std::nullopt).T_enu_gnss.T_world_body[0].t.norm(),
+            1e-4);
 }
 
 // `rigcal ground-truth` on files: an odometry with its step covariances, GNSS/INS poses, the rig.
@@ -680,6 +754,39 @@ TEST(GroundTruthCli, WritesVbrsFormatAndSigmasRefusesBadInputAndSaysWhatIsUndete
   EXPECT_NE(r.err.find("undetermined: every pose"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "y_gt.txt"));
   EXPECT_TRUE(fs::exists(dir / "late_report/ground_truth.json"));
+  // The same fixes as a CSV (RTK fixed, the default sigmas) at a given origin with --enu-origin:
+  // the same trajectory, in the same frame.
+  const std::vector<Eigen::Vector3d> sd(s.part.gnss.size(), Eigen::Vector3d(0.02, 0.02, 0.03));
+  write(dir / "fixes.csv",
+        io::gnss_fixes_csv(s.part.gnss, sd,
+                           std::vector<io::FixType>(s.part.gnss.size(), io::FixType::rtk_fixed),
+                           {41.89021, 12.492231, 69.0}));
+  r = testing::rigcal_cli(common + fmt::format(" --odometry {0}/odom.tum --covariances {0}/c.txt "
+                                               "--gnss {0}/fixes.csv --out {0}/z_gt.txt "
+                                               "--enu-origin 41.89021,12.492231,69",
+                                               dir.string()),
+                          dir);
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  const Trajectory from_fixes = io::read_trajectory(dir / "z_gt.txt").trajectory;
+  ASSERT_EQ(from_fixes.size(), gt.size());
+  for (size_t k = 0; k < gt.size(); k += 17)
+    EXPECT_LT((from_fixes.T_world_body[k].t - gt.T_world_body[k].t).norm(), 1e-3) << k;
+  // An origin for poses already in ENU, or not three numbers: refused.
+  r = testing::rigcal_cli(common + fmt::format(" --odometry {0}/odom.tum --covariances {0}/c.txt "
+                                               "--gnss {0}/rec/poses.tum --out {0}/w_gt.txt "
+                                               "--enu-origin 41.89021,12.492231,69",
+                                               dir.string()),
+                          dir);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("ENU origin applies to fixes"), std::string::npos) << r.err;
+  r = testing::rigcal_cli(common + fmt::format(" --odometry {0}/odom.tum --covariances {0}/c.txt "
+                                               "--gnss {0}/fixes.csv --out {0}/w_gt.txt "
+                                               "--enu-origin 41.89021,12.492231",
+                                               dir.string()),
+                          dir);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("LAT,LON,HEIGHT"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "w_gt.txt"));
   fs::remove_all(dir);
 }
 

@@ -11,6 +11,7 @@
 #include "rigcal/camera/lens.h"
 #include "rigcal/core/error.h"
 #include "rigcal/core/trajectory.h"
+#include "rigcal/io/sim_config.h"
 #include "rigcal/io/target_yaml.h"
 #include "rigcal/rig/rig_yaml.h"
 #include "rigcal/sim/session.h"
@@ -409,6 +410,59 @@ TEST(SimTrajectories, OdometryDriftsSlowlyAndGnssHasOutagesAndFlaggedOutliers) {
       EXPECT_LT(err, 0.2) << i;  // 5 sigma of 2-3 cm, plus interpolation of a 10 Hz truth
     }
   }
+}
+
+// Spans of float and of single fixes: their states recorded, their errors at their own sigmas,
+// and every other fix exactly as without them (they change no random draw).
+TEST(SimTrajectories, FloatAndSingleFixesHaveTheirSigmasAndChangeNothingElse) {
+  const rig::Rig rig = sample_rig();
+  SimConfig cfg;
+  cfg.trajectory_duration_s = 100;
+  cfg.gnss.outlier_probability = 0;
+  const TrajectoryPart plain = simulate_trajectories(rig, cfg);
+  io::apply_sim_config(
+      "trajectories:\n  gnss:\n    float_fixes: [[20, 50]]\n    single_fixes: [[60, 80], [45, "
+      "50]]\n    float_horizontal_sigma_m: 0.25\n",
+      "s.yaml", cfg);
+  EXPECT_DOUBLE_EQ(cfg.gnss.single_horizontal_sigma_m, 1.5);  // the default
+  const TrajectoryPart part = simulate_trajectories(rig, cfg);
+  ASSERT_EQ(part.gnss.size(), plain.gnss.size());
+  ASSERT_EQ(part.gnss_states.size(), part.gnss.size());
+  ASSERT_EQ(part.gnss_std_enu_m.size(), part.gnss.size());
+  const SE3& T_base_gnss = rig::sensor(rig, "gnss").T_base_sensor;
+  const double offset = rig::sensor(rig, "gnss").time_offset;
+  double sum2[3][3] = {}, count[3] = {};
+  for (size_t i = 0; i < part.gnss.size(); ++i) {
+    const double t = part.gnss.stamps[i].seconds() + offset - cfg.base_start_s;
+    const FixState expected = (t >= 60 && t < 80) || (t >= 45 && t < 50) ? FixState::single
+                              : t >= 20 && t < 50                        ? FixState::rtk_float
+                                                                         : FixState::rtk_fixed;
+    ASSERT_EQ(part.gnss_states[i], expected) << t;
+    const auto [h, v] = fix_sigmas(cfg.gnss, expected);
+    EXPECT_EQ(part.gnss_std_enu_m[i], Eigen::Vector3d(h, h, v));
+    if (expected == FixState::rtk_fixed) {
+      EXPECT_EQ(part.gnss.T_world_body[i].t, plain.gnss.T_world_body[i].t) << t;
+    }
+    const Eigen::Vector3d e =
+        part.gnss.T_world_body[i].t - (part.T_enu_world * part.source(t) * T_base_gnss).t;
+    const int s = static_cast<int>(expected);
+    for (int a = 0; a < 3; ++a) sum2[s][a] += e(a) * e(a);
+    ++count[s];
+  }
+  // White errors (no correlation time): thousands of fixes in each state, their rms within 10 %.
+  const double sigma[3][3] = {{0.02, 0.02, 0.03}, {0.25, 0.25, 0.4}, {1.5, 1.5, 3.0}};
+  for (int s = 0; s < 3; ++s) {
+    ASSERT_GT(count[s], 1000);
+    for (int a = 0; a < 3; ++a)
+      EXPECT_NEAR(std::sqrt(sum2[s][a] / count[s]), sigma[s][a], 0.1 * sigma[s][a]) << s << a;
+  }
+  // Their keys are checked as the others are.
+  EXPECT_THROW(
+      io::apply_sim_config("trajectories: {gnss: {single_vertical_sigma_m: -1}}\n", "s.yaml", cfg),
+      Error);
+  EXPECT_THROW(
+      io::apply_sim_config("trajectories: {gnss: {float_fixes: [[5, 1]]}}\n", "s.yaml", cfg),
+      Error);
 }
 
 TEST(SimSession, SameSeedSameOutputOtherSeedOther) {
