@@ -38,6 +38,9 @@ struct GroundTruthScore {
   double marker_rms_m = 0, marker_max_m = 0;
   double sim_seconds = 0, gt_seconds = 0;
   nlohmann::json report;
+  // The ground-truth command as it ran, without its outputs (`--out` and the rest): to run it
+  // again with other options.
+  std::string gt_inputs;
   // With `stages`: RPE over 10 m of path (rms, m) of the ground truth, of stage 1 (the pose
   // graph of rigcal's odometry and the fixes), of rigcal's odometry alone and of the GNSS/INS
   // alone (its poses through the true lever arm, its multipath outliers left out); stage 1's ATE
@@ -133,12 +136,13 @@ inline GroundTruthScore simulated_ground_truth(const std::filesystem::path& dir,
                    dir);
     if (failed(stage1)) return s;
   }
-  const CliRun run = rigcal_cli(
-      fmt::format("ground-truth {0} --rig {0}/truth.yaml {3} "
-                  "--markers {0}/trajectories/markers.csv --out {1}/gt.txt --report {1}/report "
-                  "--map {1}/map.ply {2}",
-                  rec.string(), dir.string(), args, gnss_input),
-      dir);
+  s.gt_inputs =
+      fmt::format("ground-truth {0} --rig {0}/truth.yaml {1} {2}", rec.string(), gnss_input, args);
+  const CliRun run =
+      rigcal_cli(fmt::format("{0} --markers {1}/trajectories/markers.csv --out {2}/gt.txt --report "
+                             "{2}/report --map {2}/map.ply",
+                             s.gt_inputs, rec.string(), dir.string()),
+                 dir);
   s.status = run.status;
   s.out = run.out;
   s.err = run.err;

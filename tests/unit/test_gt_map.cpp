@@ -262,6 +262,41 @@ TEST(GroundTruthSim, AShortWalksMarkersAndTrajectoryAgainstTheTruth) {
   EXPECT_EQ(ply.rfind("ply\nformat binary_little_endian 1.0\n", 0), 0u);
   EXPECT_NE(ply.find(fmt::format("element vertex {}\n", s.report["map"]["points"].get<size_t>())),
             std::string::npos);
+  // A job array: two tasks of windows (the second reaching past the plan's end), then their
+  // join, give the whole run's trajectory (to rounding: each task's motions are chained, written
+  // and taken apart again).
+  for (const auto& [name, windows] :
+       std::vector<std::pair<std::string, std::string>>{{"a", "0:4"}, {"b", "4:100"}}) {
+    const testing::CliRun task =
+        testing::rigcal_cli(fmt::format("{} --windows {} --out {}/part_{}.tum", s.gt_inputs,
+                                        windows, dir.string(), name),
+                            dir);
+    ASSERT_EQ(task.status, 0) << task.out << task.err;
+    EXPECT_NE(task.out.find("a chunk: windows"), std::string::npos) << task.out;
+    EXPECT_TRUE(fs::exists(dir / fmt::format("part_{}_covariances.txt", name)));
+  }
+  const testing::CliRun join = testing::rigcal_cli(
+      fmt::format("{0} --window-motions {1}/part_b.tum {1}/part_a.tum --out {1}/joined.txt",
+                  s.gt_inputs, dir.string()),
+      dir);
+  ASSERT_EQ(join.status, 0) << join.out << join.err;
+  const Trajectory whole = io::read_trajectory(dir / "gt.txt").trajectory;
+  const Trajectory joined = io::read_trajectory(dir / "joined.txt").trajectory;
+  ASSERT_EQ(joined.size(), whole.size());
+  double worst = 0;
+  for (size_t k = 0; k < whole.size(); ++k) {
+    EXPECT_EQ(joined.stamps[k], whole.stamps[k]);
+    worst = std::max(worst, (joined.T_world_body[k].t - whole.T_world_body[k].t).norm());
+  }
+  std::printf("[ figures ] two tasks joined against the whole run: %.2g m at most\n", worst);
+  EXPECT_LT(worst, 1e-9);
+  // A task's motions joined twice: refused.
+  const testing::CliRun twice = testing::rigcal_cli(
+      fmt::format("{0} --window-motions {1}/part_a.tum {1}/part_a.tum --out {1}/twice.txt",
+                  s.gt_inputs, dir.string()),
+      dir);
+  EXPECT_EQ(twice.status, 2) << twice.err;
+  EXPECT_NE(twice.err.find("must not overlap"), std::string::npos) << twice.err;
   fs::remove_all(dir);
 }
 
