@@ -28,7 +28,7 @@ struct Options {
   bool no_bundle_adjustment = false, photometric = false, no_fusion = false;
   size_t window_scans = gt::SequenceBaConfig{}.window_scans;
   size_t window_overlap = gt::SequenceBaConfig{}.overlap_scans;
-  std::pair<size_t, size_t> windows{0, 0};  // FROM:TO; TO 0: all
+  std::pair<size_t, size_t> windows{0, 0};  // FROM:TO; 0:0 all
   std::vector<std::string> window_motions;
 };
 
@@ -37,16 +37,9 @@ void run(const Options& o) {
   in.rig = rig::read_rig_file(o.rig);
   in.rig_source = o.rig;
   in.gnss = o.gnss.empty() ? gt::default_gnss(o.recording) : fs::path(o.gnss);
-  if (!o.scans.empty()) {
-    in.scans = lidar::scans_folder(o.scans, console_progress());
-  } else if (o.odometry.empty()) {
-    in.scans = lidar::scans_folder(o.recording, console_progress());
-  } else if (!o.no_bundle_adjustment || !o.map.empty() || !o.markers.empty()) {
-    try {  // the scans of the bundle adjustment and the map, when the recording has them
-      in.scans = lidar::scans_folder(o.recording, console_progress());
-    } catch (const Error&) {
-    }
-  }
+  in.scans = gt::scans_of(o.recording, o.scans, !o.odometry.empty(),
+                          !o.no_bundle_adjustment || !o.map.empty() || !o.markers.empty(),
+                          console_progress());
   if (!o.odometry.empty()) in.odometry = o.odometry, in.covariances = o.covariances;
   gt::StepOptions options;
   options.gnss_sensor = o.gnss_sensor;
@@ -60,13 +53,8 @@ void run(const Options& o) {
   options.ba.window_scans = o.window_scans;
   options.ba.overlap_scans = o.window_overlap;
   options.ba.window.photometric.enabled = o.photometric;
-  if (o.windows.second > 0) {
-    if (o.windows.first >= o.windows.second)
-      throw Error(
-          fmt::format("--windows {}:{}: FROM must be below TO", o.windows.first, o.windows.second));
-    options.ba.first_window = o.windows.first;
-    options.ba.end_window = o.windows.second;
-  }
+  if (o.windows != std::pair<size_t, size_t>{0, 0})
+    std::tie(options.ba.first_window, options.ba.end_window) = o.windows;
   for (const std::string& f : o.window_motions) in.window_motions.push_back(f);
   options.fuse_odometry = !o.no_fusion;
   options.map = !o.map.empty();
@@ -76,20 +64,7 @@ void run(const Options& o) {
     in.markers = io::read_marker_survey(o.markers);
     in.markers_file = o.markers;
   }
-  gt::GroundTruthPaths paths;
-  paths.trajectory = o.out;
-  paths.sigmas =
-      o.sigmas.empty() ? fs::path(o.out).replace_extension("").string() + "_sigmas.txt" : o.sigmas;
-  if (!o.report.empty()) paths.report = fs::path(o.report) / "ground_truth.json";
-  paths.map = o.map;
-  io::refuse_outputs_over_inputs(
-      {{paths.trajectory, ""}, {paths.sigmas, ""}, {paths.report, ""}, {paths.map, ""}},
-      {{"gnss", in.gnss},
-       {"markers", in.markers_file},
-       {"odometry", in.odometry},
-       {"covariances", in.covariances},
-       {"scans", in.scans},
-       {"rig", o.rig}});
+  const gt::GroundTruthPaths paths = gt::ground_truth_paths(o.out, o.sigmas, o.report, o.map, in);
 
   const gt::GroundTruthRun run = gt::run_ground_truth(in, options, console_progress());
   const gt::PoseGraphResult& g = run.graph;

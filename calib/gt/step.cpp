@@ -90,6 +90,9 @@ GroundTruthRun run_ground_truth(const StepInputs& in, const StepOptions& o,
 
   // The odometry: a file and its covariances, or rigcal's run.
   const bool chunk = o.ba.first_window > 0 || o.ba.end_window != std::numeric_limits<size_t>::max();
+  if (o.ba.first_window >= o.ba.end_window)
+    throw Error(
+        fmt::format("windows {}:{}: FROM must be below TO", o.ba.first_window, o.ba.end_window));
   if (chunk && (!in.window_motions.empty() || !o.bundle_adjustment || in.scans.empty()))
     throw Error(
         "a chunk of windows is a piece of the bundle adjustment: it needs the scans, and neither "
@@ -567,6 +570,42 @@ std::filesystem::path default_gnss(const std::filesystem::path& recording) {
     if (fs::exists(recording / name)) return recording / name;
   throw Error(fmt::format("{}: no gnss/poses.tum, gnss/fixes.csv or gnss/navsat.csv; give --gnss",
                           recording.string()));
+}
+
+fs::path scans_of(const fs::path& recording, const fs::path& given, bool odometry_given,
+                  bool wanted, const report::Progress& progress) {
+  if (!given.empty()) return lidar::scans_folder(given, progress);
+  if (!odometry_given) return lidar::scans_folder(recording, progress);
+  if (!wanted) return {};
+  try {  // the scans of the bundle adjustment and the map, when the recording has them
+    return lidar::scans_folder(recording, progress);
+  } catch (const Error&) {
+    return {};
+  }
+}
+
+GroundTruthPaths ground_truth_paths(const fs::path& out, const fs::path& sigmas,
+                                    const fs::path& report_dir, const fs::path& map,
+                                    const StepInputs& in) {
+  GroundTruthPaths paths;
+  paths.trajectory = out;
+  paths.sigmas = sigmas.empty()
+                     ? fs::path(fs::path(out).replace_extension("").string() + "_sigmas.txt")
+                     : sigmas;
+  if (!report_dir.empty()) paths.report = report_dir / "ground_truth.json";
+  paths.map = map;
+  io::refuse_outputs_over_inputs({{paths.trajectory, ""},
+                                  {paths.sigmas, ""},
+                                  {paths.report, ""},
+                                  {paths.map, ""},
+                                  {io::step_covariances_beside(out), ""}},
+                                 {{"gnss", in.gnss},
+                                  {"markers", in.markers_file},
+                                  {"odometry", in.odometry},
+                                  {"covariances", in.covariances},
+                                  {"scans", in.scans},
+                                  {"rig", in.rig_source}});
+  return paths;
 }
 
 std::vector<io::OutputFile> ground_truth_files(const GroundTruthRun& run,

@@ -137,4 +137,19 @@ std::vector<io::OutputFile> ground_truth_files(const GroundTruthRun& run,
 // Throws rigcal::Error when none is.
 std::filesystem::path default_gnss(const std::filesystem::path& recording);
 
+// The scans a run reads (lidar::scans_folder): `given` when there is one; else the recording's,
+// which must be there without an odometry (rigcal's runs on them) and are taken when they are
+// there and `wanted` (by the bundle adjustment, the map or the markers); else none.
+std::filesystem::path scans_of(const std::filesystem::path& recording,
+                               const std::filesystem::path& given, bool odometry_given, bool wanted,
+                               const report::Progress& progress = {});
+
+// A run's outputs: `out`, its sigmas (`sigmas`, or OUT without extension + _sigmas.txt), the
+// report in `report_dir` (ground_truth.json; none when empty), the map. Throws rigcal::Error
+// when one of them is one of the inputs.
+GroundTruthPaths ground_truth_paths(const std::filesystem::path& out,
+                                    const std::filesystem::path& sigmas,
+                                    const std::filesystem::path& report_dir,
+                                    const std::filesystem::path& map, const StepInputs& inputs);
+
 }  // namespace rigcal::gt
