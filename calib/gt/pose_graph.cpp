@@ -436,13 +436,25 @@ PoseGraphResult solve_pose_graph(const OdometryInput& odometry,
   return out;
 }
 
-double estimate_fix_correlation(const std::vector<PriorResidual>& priors, double max_s) {
-  std::vector<const PriorResidual*> kept;
-  for (const PriorResidual& p : priors)
-    if (!p.rejected) kept.push_back(&p);
+double estimate_fix_correlation(const std::vector<PriorResidual>& priors,
+                                const std::vector<PositionFix>& fixes, double max_s) {
+  // Each kept prior's stamp and its residual in its fix's sigmas (L^-1 r, C = L L').
+  struct Whitened {
+    Time stamp;
+    Eigen::Vector3d residual_enu;
+  };
+  std::vector<Whitened> white;
+  for (const PriorResidual& p : priors) {
+    if (p.rejected || p.fix >= fixes.size()) continue;
+    const Eigen::LLT<Eigen::Matrix3d> llt(fixes[p.fix].covariance);
+    if (llt.info() != Eigen::Success) continue;
+    white.push_back({p.stamp, llt.matrixL().solve(p.residual_enu)});
+  }
+  std::vector<const Whitened*> kept;
+  for (const Whitened& w : white) kept.push_back(&w);
   if (kept.size() < 20) return 0.0;
   std::sort(kept.begin(), kept.end(),
-            [](const PriorResidual* a, const PriorResidual* b) { return a->stamp < b->stamp; });
+            [](const Whitened* a, const Whitened* b) { return a->stamp < b->stamp; });
   // The typical spacing of consecutive priors (their median).
   std::vector<double> gaps;
   for (size_t k = 1; k < kept.size(); ++k)
@@ -451,7 +463,7 @@ double estimate_fix_correlation(const std::vector<PriorResidual>& priors, double
   const double dt = gaps[gaps.size() / 2];
   if (!(dt > 0)) return 0.0;
   double energy = 0;
-  for (const PriorResidual* p : kept) energy += p->residual_enu.squaredNorm();
+  for (const Whitened* p : kept) energy += p->residual_enu.squaredNorm();
   if (!(energy > 0)) return 0.0;
   const size_t max_lag = std::min(kept.size() / 2, size_t(std::ceil(max_s / dt)));
   for (size_t lag = 1; lag <= max_lag; ++lag) {

@@ -167,7 +167,7 @@ GroundTruthRun run_ground_truth(const StepInputs& in, const StepOptions& o,
     PoseGraphResult g = solve_pose_graph(motions, run.fixes, run.p_lidar_antenna, config);
     run.fix_correlation_estimated = true;
     for (int solves = 1; solves < 6; ++solves) {
-      const double tau = estimate_fix_correlation(g.priors);
+      const double tau = estimate_fix_correlation(g.priors, run.fixes);
       if (std::abs(tau - config.fix_correlation_s) <= 0.1 * tau) break;
       config.fix_correlation_s = tau;
       g = solve_pose_graph(motions, run.fixes, run.p_lidar_antenna, config);

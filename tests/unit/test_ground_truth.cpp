@@ -552,40 +552,65 @@ TEST(GnssFixesCsv, FixTypesReadAsCodesOrWordsAndTheWrittenFixesReadBack) {
 
 // `rigcal ground-truth` on files: an odometry with its step covariances, GNSS/INS poses, the rig.
 // The correlation time of residuals that are the fixes' errors themselves: a first-order
-// Gauss-Markov error (5 s) comes out near 5 s, outages and all; white errors give 0.
+// Gauss-Markov error (5 s) comes out near 5 s, outages and all, and with spans of fixes a
+// hundred times worse (float or single: their residuals in their own sigmas); white errors give
+// 0.
 TEST(PoseGraph, TheFixesCorrelationTimeFromResiduals) {
-  auto series = [](double tau, uint64_t seed) {
+  std::vector<gt::PositionFix> fixes;
+  auto series = [&fixes](double tau, uint64_t seed, double worse = 1.0) {
     std::mt19937_64 rng(seed);
     std::normal_distribution<double> N(0.0, 1.0);
     const double dt = 0.1, a = tau > 0 ? std::exp(-dt / tau) : 0.0;
     std::vector<gt::PriorResidual> priors;
+    fixes.clear();
     Eigen::Vector3d e(N(rng), N(rng), N(rng));
     for (int k = 0; k < 6000; ++k) {
       e = a * e + std::sqrt(1 - a * a) * Eigen::Vector3d(N(rng), N(rng), N(rng));
       if (k >= 2000 && k < 2300) continue;  // a 30 s outage
+      // 2 s of worse fixes every minute, the same error process scaled by their sigma.
+      const double sigma = 0.01 * (k % 600 < 20 ? worse : 1.0);
       gt::PriorResidual p;
       p.stamp = Time::from_seconds(100 + dt * k);
-      p.residual_enu = 0.01 * e;
+      p.residual_enu = sigma * e;
       p.rejected = k % 97 == 0;  // rejected priors are left out
+      p.fix = fixes.size();
+      fixes.push_back({p.stamp, Eigen::Vector3d::Zero(),
+                       sigma * sigma * Eigen::Matrix3d::Identity(), gt::FixQuality::rtk_fixed});
       priors.push_back(p);
     }
     return priors;
   };
-  std::vector<double> estimates;
+  std::vector<double> estimates, mixed, unwhitened;
   for (uint64_t seed = 1; seed <= 5; ++seed) {
-    estimates.push_back(gt::estimate_fix_correlation(series(5.0, seed)));
-    EXPECT_EQ(gt::estimate_fix_correlation(series(0.0, seed)), 0.0);
+    auto priors = series(5.0, seed);
+    estimates.push_back(gt::estimate_fix_correlation(priors, fixes));
+    priors = series(5.0, seed, 100.0);
+    mixed.push_back(gt::estimate_fix_correlation(priors, fixes));
+    std::vector<gt::PositionFix> alike = fixes;  // every fix said to be as good as the others
+    for (gt::PositionFix& f : alike) f.covariance = 1e-4 * Eigen::Matrix3d::Identity();
+    unwhitened.push_back(gt::estimate_fix_correlation(priors, alike));
+    priors = series(0.0, seed);
+    EXPECT_EQ(gt::estimate_fix_correlation(priors, fixes), 0.0);
   }
   std::printf("[ figures ] 10 min of fixes correlated over 5 s: estimated");
   for (double e : estimates) std::printf(" %.1f", e);
-  std::printf(" s\n");
+  std::printf(" s; with 2 s a minute of fixes 100 times worse:");
+  for (double e : mixed) std::printf(" %.1f", e);
+  std::printf(" s (taken alike:");
+  for (double e : unwhitened) std::printf(" %.1f", e);
+  std::printf(" s)\n");
   // Ten minutes hold about 120 correlation times: the autocorrelation's crossing scatters by
-  // about 15 % (seeds 1-5: 5.7, 5.6, 4.4, 6.0, 4.5 s).
-  for (double e : estimates) {
-    EXPECT_GT(e, 3.5);
-    EXPECT_LT(e, 7.0);
+  // about 15 % (seeds 1-5: 5.7, 5.6, 4.4, 6.0, 4.5 s). Taken alike (not divided by their
+  // sigmas), the worse fixes' residuals hold most of the energy and the estimate falls at their
+  // spans' edges.
+  for (const std::vector<double>* v : {&estimates, &mixed}) {
+    for (double e : *v) {
+      EXPECT_GT(e, 3.5);
+      EXPECT_LT(e, 7.0);
+    }
   }
-  EXPECT_EQ(gt::estimate_fix_correlation({}), 0.0);
+  for (double e : unwhitened) EXPECT_LT(e, 3.5);
+  EXPECT_EQ(gt::estimate_fix_correlation({}, {}), 0.0);
 }
 
 // Two estimates of 2000 motions, each step's errors drawn from its own covariance: a good along
