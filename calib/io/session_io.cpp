@@ -249,6 +249,21 @@ void write_trajectories(const fs::path& dir, const sim::TrajectoryPart& part,
       {"gnss_fixes.csv",
        "gnss_ins.tum's positions as fixes (latitude, longitude, height at enu_origin's ENU "
        "frame), with their states' sigmas and fix types"}};
+  if (part.building) {
+    const sim::Building& b = *part.building;
+    j["building"] = {
+        {"indoors_s", {b.t_in, b.t_out}},
+        {"path_indoors_m", b.length_m},
+        {"storey_m", b.storey_m()},
+        {"steps_a_flight", b.steps},
+        {"rise_m", b.rise_m},
+        {"tread_m", b.tread_m},
+        {"flights_start_m", {b.up_from_s, b.down_from_s}},
+        {"what",
+         "indoors over the first outage: in through a door at indoors_s[0], up a flight and down "
+         "another (starting flights_start_m along the path indoors), out through a door at "
+         "indoors_s[1]"}};
+  }
 }
 
 void write_trajectory_scans(const fs::path& dir, sim::SweepDrive& drive, size_t count,

@@ -130,6 +130,7 @@ void apply_sim_config(std::string_view text, std::string_view file, sim::SimConf
       {"trajectories.motion", motion(c.trajectory_motion)},
       {"trajectories.scans", flag(c.trajectory_scans)},
       {"trajectories.markers", integer(c.markers, 0, 24)},
+      {"trajectories.building", flag(c.building)},
       {"trajectories.marker_side_m", num(c.marker_side_m, 0.02, 2)},
       {"trajectories.replay",
        Setter([&](const YAML::Node& n) { c.replay_tum = (base / n.as<std::string>()).string(); })},

@@ -7,7 +7,7 @@
 //   lidar: {model: os0-128|os1-64, range_noise_m}
 //   lidar_camera: {pairs, camera, clutter}
 //   imu / os_imu: {rate_hz, jitter_s, drift_ppm, gaps: [[from, to], ...]}, imu_duration_s,
-//   imu_motion trajectories: {duration_s, motion: handheld|car|walk, replay, odometry:
+//   imu_motion trajectories: {duration_s, motion: handheld|car|walk, replay, building, odometry:
 //   {trans_sigma_m,
 //                  rot_sigma_deg, scale_error}, gnss: {rate_hz, horizontal_sigma_m,
 //                  vertical_sigma_m, rot_sigma_deg, outages: [[from, to], ...],

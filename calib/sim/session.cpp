@@ -172,6 +172,20 @@ TrajectoryPart simulate_trajectories(const rig::Rig& rig, const SimConfig& cfg,
     motion = random_motion(cfg.trajectory_motion, duration + 1.0, rng);
     source = pose_source(motion);
   }
+  if (cfg.building && cfg.trajectory_motion != MotionKind::car && !cfg.gnss.outages.empty()) {
+    // Indoors over the first outage (the earliest), within the trajectory; a car does not take
+    // the stairs.
+    const auto first = *std::min_element(cfg.gnss.outages.begin(), cfg.gnss.outages.end());
+    const double from = std::max(first.first, 0.0), to = std::min(first.second, duration);
+    if (!(to > from)) {
+      throw Error(fmt::format(
+          "the building (trajectories.building) is over the first outage, {} to {} s, which is "
+          "not within the trajectory's {} s",
+          first.first, first.second, duration));
+    }
+    part.building = std::make_shared<const Building>(plan_building(source, from, to));
+    source = climbing(source, part.building);
+  }
   const rig::Sensor& base = rig::sensor(rig, rig.base_frame);
   part.rate_hz = base.update_rate.value_or(10.0);
   const double rate = part.rate_hz;
@@ -304,8 +318,36 @@ SweepDrive trajectory_drive(const rig::Rig& rig, const SimConfig& cfg, const Tra
   std::vector<double> along_path = {0.0};
   for (size_t k = 1; k < poses.size(); ++k)
     along_path.push_back(along_path.back() + (poses[k].t - poses[k - 1].t).norm());
-  const double section = std::min(24.0, along_path.back());
-  const double section_start = 0.5 * (along_path.back() - section);
+  // The building: its walls, roof and stairs; the path outside it (2 s from its doors) must not
+  // cross them.
+  const Building* building = part.building.get();
+  auto outdoors = [&](size_t k, double margin_s) {
+    const double t = (part.truth_base.stamps[k] - part.truth_base.stamps[0]).seconds();
+    return !building || t < building->t_in - margin_s || t > building->t_out + margin_s;
+  };
+  if (building) {
+    std::vector<Eigen::Vector2d> outdoor;
+    for (size_t k = 0; k < poses.size(); ++k)
+      if (outdoors(k, 2.0)) outdoor.push_back(poses[k].t.head<2>());
+    drive.building = building_boxes(*building, z_ground, outdoor);
+    for (const Box& box : drive.building)
+      add_box(drive.scene, box.T_world_box, box.half_extents, 0.5, box.id);
+  }
+  // The markers over the middle of the path, or, with a building, of its longest stretch
+  // outdoors (3 s from the doors).
+  double stretch_from = 0.0, stretch_to = along_path.back();
+  if (building) {
+    stretch_to = stretch_from;
+    for (size_t k = 0; k < poses.size();) {
+      size_t e = k;
+      while (e < poses.size() && outdoors(e, 3.0)) ++e;
+      if (e > k && along_path[e - 1] - along_path[k] > stretch_to - stretch_from)
+        stretch_from = along_path[k], stretch_to = along_path[e - 1];
+      k = e + 1;
+    }
+  }
+  const double section = std::min(24.0, stretch_to - stretch_from);
+  const double section_start = stretch_from + 0.5 * (stretch_to - stretch_from - section);
   for (int i = 0; i < markers; ++i) {
     const double at_length = section_start + (i + 0.5) / markers * section;
     const size_t k = std::min<size_t>(
@@ -320,7 +362,9 @@ SweepDrive trajectory_drive(const rig::Rig& rig, const SimConfig& cfg, const Tra
     Eigen::Vector2d post;
     for (double side : {3.0, -3.0, 5.0, -5.0}) {
       post = at + side * (i % 2 == 0 ? left : Eigen::Vector2d(-left));
-      if (distance_to_path(post, kReach) > std::abs(side) - 0.5) break;
+      if (distance_to_path(post, kReach) > std::abs(side) - 0.5 &&
+          (!building || distance_to_indoor_path(*building, post) > building->half_width_m + 1.0))
+        break;
     }
     posts.push_back(post);
     const Eigen::Vector2d facing = (at - post).normalized();
@@ -409,6 +453,7 @@ void ground_truth_defaults(SimConfig& c) {
   // 2 s of single fixes later on.
   c.gnss.float_spans = {{16.0, 20.0}, {35.0, 39.0}};
   c.gnss.single_spans = {{48.0, 50.0}};
+  c.building = true;  // over the outage
 }
 
 ScanPart simulate_scans(const rig::Rig& rig, const SimConfig& cfg) {

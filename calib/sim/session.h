@@ -11,6 +11,7 @@
 #include "rigcal/camera/target.h"
 #include "rigcal/core/trajectory.h"
 #include "rigcal/rig/rig.h"
+#include "rigcal/sim/building.h"
 #include "rigcal/sim/imu.h"
 #include "rigcal/sim/lidar.h"
 #include "rigcal/sim/stereo.h"
@@ -57,6 +58,11 @@ struct SimConfig {
   // ground-truth`.
   int markers = -1;
   double marker_side_m = 0.2;
+  // A building over the first GNSS outage (building.h): the path goes indoors through a door,
+  // climbs a storey by stairs and comes down another flight, and leaves through a second door;
+  // the walls, roof and stairs are in the sweeps' world. Without an outage, or for a car, no
+  // building. On in the ground-truth part's defaults.
+  bool building = false;
   // scans along a trajectory in a street world
   int scans = 10;
 };
@@ -107,6 +113,8 @@ struct TrajectoryPart {
   // T_world_base at motion time (s); truth_base samples it. A replay's refers to the replayed
   // trajectory.
   PoseSource source;
+  // With SimConfig::building and an outage: the building, whose stairs `source` climbs.
+  std::shared_ptr<const Building> building;
 };
 
 struct ScanPart {
@@ -126,6 +134,7 @@ struct SweepDrive {
   std::mt19937_64 rng;
   int next = 0;                          // the next sweep's index
   std::vector<Eigen::Vector3d> markers;  // the survey markers' centres in the world frame
+  std::vector<Box> building;             // the building's walls, roof, stairs (when there is one)
 };
 // The street drive of simulate_scans: ground, box buildings, poles and parked cars along a car's
 // path.
@@ -134,7 +143,8 @@ SweepDrive street_drive(const rig::Rig& rig, const SimConfig& config);
 // a courtyard of boxes of many sizes (kiosks, walls, buildings, poles) on a ground plane around
 // the path, none nearer than 2 m to it, drawn from the part's own random stream
 // ("trajectory-scans"); config.markers survey markers (SimConfig), with no box or pole within
-// 1.5 m of their posts (the courtyard is otherwise the same as without them).
+// 1.5 m of their posts (the courtyard is otherwise the same as without them); the part's
+// building, if it has one (then the markers go along the longest stretch of path outdoors).
 SweepDrive trajectory_drive(const rig::Rig& rig, const SimConfig& config,
                             const TrajectoryPart& part);
 struct Sweep {
@@ -150,7 +160,7 @@ Sweep next_sweep(SweepDrive& drive);
 // 60 s walk with the LiDAR's sweeps (64 beams over 90 deg, 1024 columns: a quarter of an
 // OS0-128's points, a few hundred MB), 6 survey markers, RTK noise of 1 cm horizontal and 2 cm
 // vertical correlated over 5 s, a 15 s outage with 4 s of float fixes on each side, and 2 s of
-// single fixes.
+// single fixes; the outage indoors, in a building with stairs (SimConfig::building).
 void ground_truth_defaults(SimConfig& config);
 
 StereoPart simulate_stereo(const rig::Rig& rig, const SimConfig& config);

@@ -465,6 +465,103 @@ TEST(SimTrajectories, FloatAndSingleFixesHaveTheirSigmasAndChangeNothingElse) {
       Error);
 }
 
+// The ground-truth recording's building (SimConfig::building): over the outage the path goes in
+// through a door, climbs a storey and comes down again, and leaves through another door without
+// coming near a wall; sweeps indoors see walls and roof all around within a few metres; no fix
+// indoors. Off, the part is what it was.
+TEST(SimTrajectories, TheBuildingOverTheOutageHasDoorsStairsWallsAndRoof) {
+  const rig::Rig rig = sample_rig();
+  SimConfig cfg;
+  ground_truth_defaults(cfg);
+  cfg.trajectory_duration_s = 30;
+  cfg.gnss.outages = {{8.0, 22.0}};
+  cfg.gnss.float_spans.clear();
+  cfg.gnss.single_spans.clear();
+  cfg.markers = 0;
+  cfg.lidar.beams = 32;
+  cfg.lidar.columns = 512;
+  const TrajectoryPart part = simulate_trajectories(rig, cfg);
+  ASSERT_TRUE(part.building);
+  const Building& b = *part.building;
+  EXPECT_DOUBLE_EQ(b.t_in, 8.0);
+  EXPECT_DOUBLE_EQ(b.t_out, 22.0);
+  // No fix indoors.
+  const double offset = rig::sensor(rig, "gnss").time_offset;
+  for (const Time& stamp : part.gnss.stamps) {
+    const double t = stamp.seconds() + offset - cfg.base_start_s;
+    EXPECT_FALSE(t >= 8.0 && t < 22.0) << t;
+  }
+  // The height: a storey up and back to the ground (the walk's own bob is 2 cm).
+  const std::vector<SE3>& poses = part.truth_base.T_world_body;
+  double z_before = 0, z_top = -1e9, z_after = 0;
+  for (size_t k = 0; k < poses.size(); ++k) {
+    const double t = 0.1 * double(k);
+    if (t < 8.0) z_before = std::max(z_before, std::abs(poses[k].t.z() - poses[0].t.z()));
+    if (t > 8.0 && t < 22.0) z_top = std::max(z_top, poses[k].t.z() - poses[0].t.z());
+    if (t > 22.0) z_after = std::max(z_after, std::abs(poses[k].t.z() - poses[0].t.z()));
+  }
+  EXPECT_LT(z_before, 0.1);
+  EXPECT_NEAR(z_top, b.storey_m(), 0.1);
+  EXPECT_NEAR(b.storey_m(), 2.55, 1e-9);
+  EXPECT_LT(z_after, 0.1);
+  SweepDrive drive = trajectory_drive(rig, cfg, part);
+  ASSERT_FALSE(drive.building.empty());
+  // No wall within 0.4 m of the path, horizontally; a door's lintel at least 0.3 m above it.
+  double nearest = 1e9, headroom = 1e9, z_ground = 1e9;
+  int walls = 0, lintels = 0, steps = 0;
+  for (const Box& box : drive.building)
+    z_ground = std::min(z_ground, box.T_world_box.t.z() - box.half_extents.z());
+  for (const Box& box : drive.building) {
+    steps += box.id == kBuildingStairs;
+    if (box.id != kBuildingWall) continue;
+    const double bottom = box.T_world_box.t.z() - box.half_extents.z();
+    const bool lintel = bottom > z_ground + 1.0;
+    ++(lintel ? lintels : walls);
+    for (const SE3& T : poses) {
+      const Eigen::Vector3d q = box.T_world_box.inverse() * T.t;
+      const Eigen::Vector2d outside =
+          (q.head<2>().cwiseAbs() - box.half_extents.head<2>()).cwiseMax(0.0);
+      if (lintel) {
+        if (outside.norm() == 0) headroom = std::min(headroom, bottom - T.t.z());
+      } else {
+        nearest = std::min(nearest, outside.norm());
+      }
+    }
+  }
+  EXPECT_GT(walls, 20);
+  EXPECT_EQ(lintels, 2);  // one door in, one out
+  EXPECT_EQ(steps, 2 * b.steps);
+  EXPECT_GT(nearest, 0.4);
+  EXPECT_GT(headroom, 0.3);
+  std::printf(
+      "[ figures ] building: %.1f m of path indoors, %d wall boxes, the path %.2f m from the "
+      "nearest wall, %.2f m below the lintels\n",
+      b.length_m, walls, nearest, headroom);
+  // Sweeps in the entrance hall, on the stairs and on the gallery: points of the building within
+  // 6 m in each of 8 directions, walls and roof among them.
+  for (const double t : {8.5, 8.0 + 4.0 / 1.3, 15.0}) {
+    drive.next = static_cast<int>(std::lround(t * part.rate_hz));
+    const Sweep s = next_sweep(drive);
+    int sector_hits[8] = {}, roof = 0, wall = 0;
+    for (const LidarPoint& p : s.points) {
+      roof += p.object == kBuildingRoof;
+      wall += p.object == kBuildingWall;
+      if (p.object < kBuildingWall || p.object > kBuildingGallery || p.p.norm() > 6.0f) continue;
+      const double a = std::atan2(p.p.y(), p.p.x()) + M_PI;
+      ++sector_hits[std::min(7, static_cast<int>(a / (M_PI / 4)))];
+    }
+    EXPECT_GT(roof, 100) << t;
+    EXPECT_GT(wall, 100) << t;
+    for (int i = 0; i < 8; ++i) EXPECT_GT(sector_hits[i], 10) << t << " sector " << i;
+  }
+  // Off (the default elsewhere): no building, the same path as without the key.
+  cfg.building = false;
+  const TrajectoryPart flat = simulate_trajectories(rig, cfg);
+  EXPECT_FALSE(flat.building);
+  EXPECT_NEAR(flat.truth_base.T_world_body[150].t.z(), poses[0].t.z(), 0.1);
+  EXPECT_EQ(flat.truth_base.T_world_body[50].t, poses[50].t);  // before the building
+}
+
 TEST(SimSession, SameSeedSameOutputOtherSeedOther) {
   const rig::Rig rig = sample_rig();
   SimConfig cfg;
