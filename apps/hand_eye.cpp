@@ -46,25 +46,10 @@ void run(const Options& o) {
     so.refine.fixed.push_back(p);
   so.max_sigma_m = o.max_sigma_m;
   so.estimate_offset = o.estimate_offset;
-  hand_eye::StepInputs in;
   so.odometry_preset = o.odometry_preset;
   so.odometry_sweep_motion = !o.no_sweep_motion;
-  in.lidar = o.lidar, in.gnss = o.gnss, in.rig_source = o.rig;
-  if (!o.lidar.empty() && !o.scans.empty()) throw Error("give --lidar or --scans, not both");
-  if (!o.scans.empty()) in.lidar_scans = lidar::scans_folder(o.scans, console_progress());
-  if (!o.session.empty()) {  // what the session names, unless given
-    const io::Session s = io::read_session(o.session, console_progress());
-    if (in.lidar.empty() && in.lidar_scans.empty()) in.lidar = s.odometry;
-    if (in.gnss.empty()) in.gnss = s.gnss;
-  }
-  if ((in.lidar.empty() && in.lidar_scans.empty()) || in.gnss.empty())
-    throw Error(
-        "give --lidar (or --scans) and --gnss, or a --session whose session.yaml names "
-        "odometry and gnss");
-  io::refuse_outputs_over_inputs({{o.out, ""}}, {{"--lidar", in.lidar},
-                                                 {"--scans", in.lidar_scans},
-                                                 {"--gnss", in.gnss}});  // --rig may be --out
-  if (!o.rig.empty()) in.rig = rig::read_rig_file(o.rig);
+  const hand_eye::StepInputs in =
+      hand_eye::step_inputs(o.lidar, o.scans, o.gnss, o.session, o.rig, o.out, console_progress());
   const report::StepResult r = hand_eye::estimate_extrinsic(in, so, console_progress());
   finish_step(r, o.out, o.report);
   if (!o.out.empty()) fmt::print("{}: T_b written to {}\n", fmt::join(r.wrote, ", "), o.out);

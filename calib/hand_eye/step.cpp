@@ -11,10 +11,13 @@
 #include "rigcal/core/text.h"
 #include "rigcal/core/version.h"
 #include "rigcal/hand_eye/report.h"
+#include "rigcal/io/files.h"
 #include "rigcal/io/gnss_fixes.h"
 #include "rigcal/io/odometry_io.h"
+#include "rigcal/io/session.h"
 #include "rigcal/lidar/step.h"
 #include "rigcal/report/json.h"
+#include "rigcal/rig/rig_yaml.h"
 
 namespace rigcal::hand_eye {
 namespace {
@@ -346,6 +349,30 @@ report::StepResult estimate(const StepInputs& in, const StepOptions& o, const Tr
 }
 
 }  // namespace
+
+StepInputs step_inputs(const std::filesystem::path& odometry, const std::filesystem::path& scans,
+                       const std::filesystem::path& gnss, const std::filesystem::path& session,
+                       const std::filesystem::path& rig, const std::filesystem::path& out,
+                       const report::Progress& progress) {
+  StepInputs in;
+  in.lidar = odometry, in.gnss = gnss, in.rig_source = rig.string();
+  if (!odometry.empty() && !scans.empty()) throw Error("give --lidar or --scans, not both");
+  if (!scans.empty()) in.lidar_scans = lidar::scans_folder(scans, progress);
+  if (!session.empty()) {  // what the session names, unless given
+    const io::Session s = io::read_session(session, progress);
+    if (in.lidar.empty() && in.lidar_scans.empty()) in.lidar = s.odometry;
+    if (in.gnss.empty()) in.gnss = s.gnss;
+  }
+  if ((in.lidar.empty() && in.lidar_scans.empty()) || in.gnss.empty())
+    throw Error(
+        "give --lidar (or --scans) and --gnss, or a --session whose session.yaml names "
+        "odometry and gnss");
+  io::refuse_outputs_over_inputs({{out, ""}}, {{"--lidar", in.lidar},
+                                               {"--scans", in.lidar_scans},
+                                               {"--gnss", in.gnss}});  // --rig may be --out
+  if (!rig.empty()) in.rig = rig::read_rig_file(rig);
+  return in;
+}
 
 report::StepResult estimate_extrinsic(const StepInputs& in, const StepOptions& o,
                                       const report::Progress& progress) {

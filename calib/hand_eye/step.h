@@ -42,6 +42,16 @@ struct StepInputs {
   std::string rig_source;       // where the rig came from, for the report
 };
 
+// The inputs of a run from what a command was given: `odometry` (T_odom_lidar, --lidar) or
+// `scans` (not both), `gnss`, and for the ones not given what the session folder `session` names in
+// its session.yaml (odometry, gnss); the rig read from `rig` when given. Throws rigcal::Error when
+// an input is missing or both of lidar and scans are given, or when `out` is one of the inputs
+// (`rig` may be `out`: the sensor's T_b is written into it).
+StepInputs step_inputs(const std::filesystem::path& odometry, const std::filesystem::path& scans,
+                       const std::filesystem::path& gnss, const std::filesystem::path& session,
+                       const std::filesystem::path& rig, const std::filesystem::path& out,
+                       const report::Progress& progress = {});
+
 // Translation components held (`--fix AXIS=METRES`) or given a prior (`with_sigma`: `--prior
 // AXIS=METRES,SIGMA`), AXIS x, y or z of the GNSS/INS frame. Throws rigcal::Error naming the
 // option and what it expects.

@@ -83,14 +83,7 @@ std::string_view to_string(FixType type) {
 }
 
 GeodeticOrigin parse_geodetic_origin(std::string_view text, std::string_view what) {
-  std::vector<std::string_view> f;
-  size_t from = 0;
-  for (;;) {
-    const size_t comma = text.find(',', from);
-    f.push_back(trim(text.substr(from, comma == std::string_view::npos ? comma : comma - from)));
-    if (comma == std::string_view::npos) break;
-    from = comma + 1;
-  }
+  const std::vector<std::string_view> f = split_fields(text);
   const std::string expected = fmt::format(
       "{}: expected LAT,LON,HEIGHT (degrees, degrees, ellipsoidal m), got '{}'", what, text);
   if (f.size() != 3) throw Error(expected);
