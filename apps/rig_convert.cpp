@@ -5,6 +5,7 @@
 
 #include "cli.h"
 #include "rigcal/rig/export.h"
+#include "rigcal/rig/import.h"
 #include "rigcal/rig/rig_yaml.h"
 
 namespace rigcal::cli {
@@ -29,14 +30,16 @@ void add_rig_convert(CLI::App& parent) {
       "  ros     one camera_info YAML per camera into the folder --out\n"
       "  mrcal   one .cameramodel per camera into the folder --out\n"
       "Files are written to a temporary name and renamed: a failed run writes nothing.");
-  cmd->add_option("file", o->file, "calibration YAML")->required();
+  cmd->add_option("file", o->file,
+                  "calibration file (rigcal, VBR, Kalibr camchain, ROS camera_info, OpenCV, mrcal)")
+      ->required();
   cmd->add_option("--to", o->to, "rigcal | vbr | kalibr | opencv | ros | mrcal")->required();
   cmd->add_option("--out", o->out, "output file (a folder for ros and mrcal)")->required();
   cmd->add_option("--imu", o->imu,
                   "kalibr: the IMU for T_cam_imu (default: the sensor 'imu', else the first IMU)");
   cmd->callback([o] {
     const rig::ExportFormat format = rig::export_format_from_string(o->to);
-    const rig::Rig r = rig::read_rig_file(o->file);
+    const rig::Rig r = rig::read_calibration_file(o->file);
     const std::vector<io::OutputFile> files =
         rig::export_files(r, format, o->out, rig::ExportOptions{o->imu});
     io::refuse_outputs_over_inputs(files, {{"the calibration", o->file}});

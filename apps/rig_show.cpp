@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "cli.h"
+#include "rigcal/rig/import.h"
 #include "rigcal/rig/rig_yaml.h"
 #include "rigcal/session/provenance.h"
 
@@ -111,8 +112,10 @@ void add_rig_show(CLI::App& parent) {
       "show",
       "Print the rig as tables: every sensor's pose in the base frame (translation and\n"
       "roll/pitch/yaw in degrees), clock offsets, camera intrinsics, stereo baseline, IMU noise.");
-  cmd->add_option("file", *file, "calibration YAML")->required();
-  cmd->callback([file] { print_rig(*file, rig::read_rig_file(*file)); });
+  cmd->add_option("file", *file,
+                  "calibration file (rigcal, VBR, Kalibr camchain, ROS camera_info, OpenCV, mrcal)")
+      ->required();
+  cmd->callback([file] { print_rig(*file, rig::read_calibration_file(*file)); });
 }
 
 }  // namespace rigcal::cli

@@ -16,7 +16,7 @@ namespace {
 // Projection with the intrinsics block k = [fx fy cx cy d...] (radtan: k1 k2 p1 p2 [k3];
 // equidistant: k1..k4), OpenCV's formulas (calib/camera/lens.h).
 template <typename T>
-void project(const T* k, bool radtan, int n_coeffs, const T* p, T* uv) {
+void project_with(const T* k, bool radtan, int n_coeffs, const T* p, T* uv) {
   const T x = p[0] / p[2], y = p[1] / p[2];
   const T r2 = x * x + y * y;
   T xd, yd;
@@ -46,7 +46,7 @@ template <typename T>
 bool residual(const T* k, bool radtan, int n_coeffs, const Eigen::Matrix<T, 3, 1>& p,
               const Eigen::Vector2d& observed, T* r) {
   T uv[2];
-  project(k, radtan, n_coeffs, p.data(), uv);
+  project_with(k, radtan, n_coeffs, p.data(), uv);
   r[0] = uv[0] - T(observed.x());
   r[1] = uv[1] - T(observed.y());
   return true;
@@ -332,7 +332,7 @@ void update_residuals(std::vector<CornerResidual>& residuals,
     Eigen::Vector3d p = b.q * object[cr.point] + b.t;
     if (cr.camera > 0) p = x.cam_pose[cr.camera].q * p + x.cam_pose[cr.camera].t;
     Eigen::Vector2d uv;
-    project(x.intr[cr.camera].data(), lens.radtan, lens.n_coeffs, p.data(), uv.data());
+    project_with(x.intr[cr.camera].data(), lens.radtan, lens.n_coeffs, p.data(), uv.data());
     cr.residual = uv - cr.observed;
   }
 }

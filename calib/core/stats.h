@@ -33,4 +33,27 @@ inline double rms(const std::vector<double>& v) {
   return v.empty() ? 0.0 : std::sqrt(sum / double(v.size()));
 }
 
+// P(X >= x) for X chi-square with `dof` degrees of freedom (dof >= 1): the probability of a
+// squared Mahalanobis distance at least x when nothing but noise made it. Closed forms by the
+// parity of dof (Abramowitz and Stegun 26.4.4 and 26.4.5).
+inline double chi2_upper_tail(double x, int dof) {
+  if (!(x > 0)) return 1.0;
+  const double h = 0.5 * x;
+  double sum = 0, term = 0;
+  if (dof % 2 == 0) {
+    term = 1.0;
+    for (int k = 0; k < dof / 2; ++k) {
+      if (k > 0) term *= h / k;
+      sum += term;
+    }
+    return std::min(1.0, std::exp(-h) * sum);
+  }
+  term = std::sqrt(x) * std::sqrt(2.0 / M_PI);
+  for (int k = 1; k <= (dof - 1) / 2; ++k) {
+    if (k > 1) term *= x / (2 * k - 1);
+    sum += term;
+  }
+  return std::min(1.0, std::erfc(std::sqrt(h)) + std::exp(-h) * sum);
+}
+
 }  // namespace rigcal

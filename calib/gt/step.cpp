@@ -132,11 +132,18 @@ GroundTruthRun run_ground_truth(const StepInputs& in, const StepOptions& o,
     run.fixes = position_fixes(on_base_clock(f.T_enu_gnss, *gnss), f.std_enu_m, f.status, 0.0,
                                o.pose_graph, quality);
     if (f.std_enu_m.empty()) {
-      run.notes.push_back(fmt::format(
-          "{} gives no standard deviations: every fix taken as {} (horizontal {} m, vertical {} m)",
-          in.gnss.string(),
-          f.fix_type.empty() && f.status.empty() ? "RTK fixed" : "its fix type or status says",
-          o.pose_graph.sigma_rtk_fixed.x(), o.pose_graph.sigma_rtk_fixed.y()));
+      const PoseGraphConfig& c = o.pose_graph;
+      run.notes.push_back(
+          f.fix_type.empty() && f.status.empty()
+              ? fmt::format("{} gives no standard deviations and no fix states: every fix taken "
+                            "as RTK fixed (horizontal {} m, vertical {} m)",
+                            in.gnss.string(), c.sigma_rtk_fixed.x(), c.sigma_rtk_fixed.y())
+              : fmt::format("{} gives no standard deviations: each fix's sigmas (horizontal, "
+                            "vertical) by its fix state: RTK fixed {} / {} m, float {} / {} m, "
+                            "single {} / {} m",
+                            in.gnss.string(), c.sigma_rtk_fixed.x(), c.sigma_rtk_fixed.y(),
+                            c.sigma_rtk_float.x(), c.sigma_rtk_float.y(), c.sigma_single.x(),
+                            c.sigma_single.y()));
     }
   } else {
     if (o.enu_origin) {

@@ -98,7 +98,9 @@ std::string render_svg(const Plot& plot) {
   // The lambdas copy the bindings: clang 14 (the sanitizer build) cannot capture a binding.
   const auto [x0, x1, y0, y1, v0, v1, sx, sy] = bounds(plot, pw, ph);
   auto X = [&, x0 = x0, sx = sx](double x) { return kLeft + (x - x0) * sx; };
-  auto Y = [&, y0 = y0, sy = sy](double y) { return kTop + ph - (y - y0) * sy; };
+  auto Y = [&, y0 = y0, sy = sy](double y) {
+    return plot.y_down ? kTop + (y - y0) * sy : kTop + ph - (y - y0) * sy;
+  };
 
   std::string out = fmt::format(
       "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" height=\"{}\" "
@@ -193,7 +195,9 @@ std::string render_png(const Plot& plot) {
   // The lambdas copy the bindings: clang 14 (the sanitizer build) cannot capture a binding.
   const auto [x0, x1, y0, y1, v0, v1, sx, sy] = bounds(plot, pw, ph);
   auto X = [&, x0 = x0, sx = sx](double x) { return kLeft + (x - x0) * sx; };
-  auto Y = [&, y0 = y0, sy = sy](double y) { return kTop + ph - (y - y0) * sy; };
+  auto Y = [&, y0 = y0, sy = sy](double y) {
+    return plot.y_down ? kTop + (y - y0) * sy : kTop + ph - (y - y0) * sy;
+  };
   auto P = [](double x, double y) { return cv::Point(cvRound(x), cvRound(y)); };
   cv::Mat img(static_cast<int>(kH), static_cast<int>(kW), CV_8UC3, cv::Scalar(255, 255, 255));
   const int font = cv::FONT_HERSHEY_SIMPLEX;

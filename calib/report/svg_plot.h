@@ -18,6 +18,7 @@ struct Plot {
   std::vector<PlotSeries> series;
   bool equal_axes = false;  // same scale on x and y (top views)
   bool step = false;        // draw lines as steps (cumulative curves)
+  bool y_down = false;      // y grows downwards (image rows)
 };
 
 std::string render_svg(const Plot& plot);

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 
 #include "ground_truth_sim.h"
@@ -18,13 +19,18 @@ namespace {
 
 // `odometry_rpe_factor`: the ground truth's RPE over 10 m at most this times the odometry's (1:
 // better than it, the acceptance's bar).
+// RIGCAL_GT_ARGS, when set, is given to every `rigcal ground-truth` of the acceptance (the bound
+// with the true motions included), to measure an option's effect on the same recordings:
+// RIGCAL_GT_ARGS='--fix-correlation 5' (doc/ground-truth.md).
 void acceptance(const std::string& name, const std::string& config, double odometry_rpe_factor) {
   namespace fs = std::filesystem;
+  const char* extra = std::getenv("RIGCAL_GT_ARGS");
+  const std::string extra_args = extra ? extra : "";
   for (uint64_t seed = 1; seed <= 3; ++seed) {
     const fs::path dir =
         fs::temp_directory_path() / fmt::format("rigcal_gt_long_{}_{}_{}", name, seed, ::getpid());
     const testing::GroundTruthScore s =
-        testing::simulated_ground_truth(dir, seed, config, "", /*stages=*/true);
+        testing::simulated_ground_truth(dir, seed, config, extra_args, /*stages=*/true);
     ASSERT_EQ(s.status, 0) << s.out << s.err;
     const nlohmann::json& summary = s.report["summary"];
     std::printf(

@@ -14,11 +14,13 @@
 #include <nlohmann/json.hpp>
 #include <random>
 #include <set>
+#include <sstream>
 
 #include "cli_run.h"
 #include "rigcal/bench/metrics.h"
 #include "rigcal/core/error.h"
 #include "rigcal/core/stats.h"
+#include "rigcal/core/text.h"
 #include "rigcal/gt/motion_fusion.h"
 #include "rigcal/gt/pose_graph.h"
 #include "rigcal/io/gnss_fixes.h"
@@ -796,6 +798,27 @@ TEST(GroundTruthCli, WritesVbrsFormatAndSigmasRefusesBadInputAndSaysWhatIsUndete
   ASSERT_EQ(from_fixes.size(), gt.size());
   for (size_t k = 0; k < gt.size(); k += 17)
     EXPECT_LT((from_fixes.T_world_body[k].t - gt.T_world_body[k].t).norm(), 1e-3) << k;
+  // The same fixes with their fix states and no standard deviations: the note names the sigmas
+  // each state is given.
+  {
+    std::istringstream in(testing::slurp(dir / "fixes.csv"));
+    std::string line, states;
+    while (std::getline(in, line)) {
+      const std::vector<std::string_view> f = split_fields(line);
+      ASSERT_EQ(f.size(), 9u) << line;
+      states += fmt::format("{},{},{},{},{}\n", f[0], f[1], f[2], f[3], f[8]);
+    }
+    write(dir / "states.csv", states);
+  }
+  r = testing::rigcal_cli(common + fmt::format(" --odometry {0}/odom.tum --covariances {0}/c.txt "
+                                               "--gnss {0}/states.csv --out {0}/s_gt.txt "
+                                               "--enu-origin 41.89021,12.492231,69",
+                                               dir.string()),
+                          dir);
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_NE((r.out + r.err).find("by its fix state: RTK fixed 0.02 / 0.03 m, float 0.3 / 0.5 m"),
+            std::string::npos)
+      << r.out << r.err;
   // An origin for poses already in ENU, or not three numbers: refused.
   r = testing::rigcal_cli(common + fmt::format(" --odometry {0}/odom.tum --covariances {0}/c.txt "
                                                "--gnss {0}/rec/poses.tum --out {0}/w_gt.txt "

@@ -3,8 +3,12 @@
 #include <random>
 
 #include "rigcal/rig/rig.h"
+#include "rigcal/rig/rig_yaml.h"
 
 namespace rigcal::rig::testing {
+
+// The bundled sample rig (data/sample_rig.yaml): two cameras, the LiDAR, two IMUs, a GNSS/INS.
+inline Rig sample_rig() { return read_rig_file(RIGCAL_SOURCE_DIR "/data/sample_rig.yaml"); }
 
 inline double any_double(std::mt19937_64& rng, double lo, double hi) {
   return std::uniform_real_distribution<double>(lo, hi)(rng);

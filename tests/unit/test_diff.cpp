@@ -1,0 +1,260 @@
+// rigcal diff (calib/session/diff.h): a calibration against itself is zero everywhere; a known
+// change comes back as made, in the frames and units documented, with its significance against
+// the stored sigmas; the projection difference against closed forms.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "cli_run.h"
+#include "rigcal/core/error.h"
+#include "rigcal/core/stats.h"
+#include "rigcal/rig/export.h"
+#include "rigcal/rig/rig_yaml.h"
+#include "rigcal/session/diff.h"
+#include "rigcal/session/provenance.h"
+#include "test_rigs.h"
+
+namespace rigcal {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+using rig::testing::sample_rig;
+
+// The sigmas a calibrate run would store: the stereo extrinsic's, the LiDAR-camera's, cam_r's
+// intrinsics and the IMU's clock.
+void store_sigmas(rig::Rig& rig) {
+  session::StepRecord cameras{"cameras", "ok", "test", "", {}, {}, {}};
+  for (const char* p : {"fx", "fy", "cx", "cy"})
+    cameras.sigmas.push_back({fmt::format("cam_r.{}_px", p), 0.5, ""});
+  session::StepRecord lidar_camera{"lidar_camera", "ok", "test", "", {}, {}, {}};
+  for (int i = 0; i < 3; ++i) {
+    lidar_camera.sigmas.push_back({fmt::format("T_cam_r_lidar.t.{}_m", "xyz"[i]), 0.001, ""});
+    lidar_camera.sigmas.push_back(
+        {fmt::format("T_cam_r_lidar.rotation.{}_deg", "xyz"[i]), 0.05, ""});
+  }
+  session::StepRecord time_sync{"time_sync", "ok", "test", "", {}, {}, {}};
+  time_sync.sigmas.push_back({"imu.time_offset_s", 1e-4, ""});
+  rig.extra_metadata.emplace_back("steps", session::steps_yaml({cameras, lidar_camera, time_sync}));
+}
+
+TEST(Chi2UpperTail, MatchesTabulatedQuantiles) {
+  // The 95 % and 99.9 % points of chi-square (tables), and a closed form.
+  EXPECT_NEAR(chi2_upper_tail(3.841459, 1), 0.05, 1e-6);
+  EXPECT_NEAR(chi2_upper_tail(5.991465, 2), 0.05, 1e-6);
+  EXPECT_NEAR(chi2_upper_tail(7.814728, 3), 0.05, 1e-6);
+  EXPECT_NEAR(chi2_upper_tail(12.591587, 6), 0.05, 1e-6);
+  EXPECT_NEAR(chi2_upper_tail(16.266236, 3), 0.001, 1e-7);
+  EXPECT_NEAR(chi2_upper_tail(2.0, 2), std::exp(-1.0), 1e-12);
+  EXPECT_EQ(chi2_upper_tail(0.0, 4), 1.0);
+}
+
+TEST(Diff, ACalibrationAgainstItselfIsZero) {
+  rig::Rig a = sample_rig();
+  store_sigmas(a);
+  const session::RigDifference d = session::diff_rigs(a, a);
+  // Each sensor but the base (five), and the relation a step stored sigmas of, T_cam_r_lidar.
+  ASSERT_EQ(d.poses.size(), 6u);
+  for (const session::PoseDifference& p : d.poses) {
+    // R R' of a stored rotation is the identity to rounding.
+    EXPECT_LT(p.rotation_rad.norm(), 1e-15) << p.a << " " << p.b;
+    EXPECT_EQ(p.translation_m.norm(), 0.0) << p.a << " " << p.b;
+  }
+  for (const session::ClockDifference& c : d.clocks) EXPECT_EQ(c.offset_s, 0.0) << c.sensor;
+  ASSERT_EQ(d.cameras.size(), 2u);
+  for (const session::CameraDifference& c : d.cameras) {
+    for (double v : c.values) EXPECT_EQ(v, 0.0) << c.camera;
+    ASSERT_TRUE(c.projection) << c.note;
+    EXPECT_LT(c.projection->raw_max_px, 1e-9);
+    EXPECT_LT(c.projection->fitted_max_px, 1e-9);
+    EXPECT_EQ(c.projection->columns * c.projection->rows, int(c.projection->u.size()));
+  }
+  EXPECT_TRUE(d.only_in_a.empty());
+  EXPECT_TRUE(d.only_in_b.empty());
+}
+
+TEST(Diff, AKnownChangeComesBackAsMadeWithItsSignificance) {
+  rig::Rig a = sample_rig();
+  store_sigmas(a);
+  rig::Rig b = a;
+  // cam_r turned by phi about the base frame's axes and moved by dt there, its fx and cx
+  // changed; the IMU's clock 2 ms later.
+  const Eigen::Vector3d phi = Eigen::Vector3d(0.1, -0.2, 0.15) * kDeg;
+  const Eigen::Vector3d dt(0.003, -0.001, 0.002);
+  rig::Sensor& cam_r = rig::sensor(b, "cam_r");
+  cam_r.T_base_sensor.R = rotation_from_vector(phi) * cam_r.T_base_sensor.R;
+  cam_r.T_base_sensor.t += dt;
+  cam_r.camera.fx += 1.5;
+  cam_r.camera.cx -= 2.0;
+  rig::sensor(b, "imu").time_offset += 0.002;
+
+  const session::RigDifference d = session::diff_rigs(a, b);
+  const SE3 T_base_cam_r = rig::sensor(a, "cam_r").T_base_sensor;
+  bool base_pose = false, lidar_camera = false;
+  for (const session::PoseDifference& p : d.poses) {
+    if (p.a == "lidar" && p.b == "cam_r") {
+      base_pose = true;
+      EXPECT_LT((p.rotation_rad - phi).norm(), 1e-12);
+      EXPECT_LT((p.translation_m - dt).norm(), 1e-12);
+    } else if (p.a == "cam_r" && p.b == "lidar") {
+      // T_cam_r_lidar = T_base_cam_r^-1 (the base is the LiDAR): its rotation turns by
+      // -R' phi about cam_r's axes, its translation t = -R' t_b changes by -R_B' (t_A + dt) + R_A'
+      // t_A.
+      lidar_camera = true;
+      const Eigen::Matrix3d R_a = T_base_cam_r.R, R_b = rotation_from_vector(phi) * R_a;
+      EXPECT_LT((p.rotation_rad + R_a.transpose() * phi).norm(), 1e-12);
+      const Eigen::Vector3d expected =
+          -R_b.transpose() * (T_base_cam_r.t + dt) + R_a.transpose() * T_base_cam_r.t;
+      EXPECT_LT((p.translation_m - expected).norm(), 1e-12);
+      ASSERT_TRUE(p.significance);
+      EXPECT_EQ(p.significance->dof, 6);
+      // Both calibrations store the same sigmas: combined sqrt(2) times them.
+      double chi2 = 0;
+      for (int i = 0; i < 3; ++i) {
+        chi2 += std::pow(p.rotation_rad[i] / (std::sqrt(2.0) * 0.05 * kDeg), 2);
+        chi2 += std::pow(p.translation_m[i] / (std::sqrt(2.0) * 0.001), 2);
+      }
+      EXPECT_NEAR(p.significance->chi2, chi2, 1e-9 * chi2);
+      EXPECT_NEAR(p.significance->p_value, chi2_upper_tail(chi2, 6), 1e-15);
+      EXPECT_LT(p.significance->p_value, 0.01);  // 0.27 deg and 3.7 mm against 0.07 and 1.4
+    } else {
+      EXPECT_LT(p.rotation_rad.norm(), 1e-15) << p.a << " " << p.b;
+      EXPECT_EQ(p.translation_m.norm(), 0.0) << p.a << " " << p.b;
+      EXPECT_FALSE(p.significance) << p.a << " " << p.b;
+    }
+  }
+  EXPECT_TRUE(base_pose);
+  EXPECT_TRUE(lidar_camera);
+  for (const session::ClockDifference& c : d.clocks) {
+    if (c.sensor != "imu") {
+      EXPECT_EQ(c.offset_s, 0.0) << c.sensor;
+      continue;
+    }
+    EXPECT_NEAR(c.offset_s, 0.002, 1e-15);
+    ASSERT_TRUE(c.significance);
+    EXPECT_NEAR(c.significance->chi2, std::pow(0.002 / (std::sqrt(2.0) * 1e-4), 2), 1e-6);
+  }
+  for (const session::CameraDifference& c : d.cameras) {
+    ASSERT_TRUE(c.projection);
+    if (c.camera == "cam_l") {
+      EXPECT_LT(c.projection->raw_max_px, 1e-9);
+      continue;
+    }
+    EXPECT_EQ(c.values[0], 1.5);
+    EXPECT_EQ(c.values[2], -2.0);
+    ASSERT_TRUE(c.significance);
+    EXPECT_NEAR(c.significance->chi2, (1.5 * 1.5 + 2.0 * 2.0) / (2 * 0.25), 1e-9);
+    // A pixel's ray by A, projected by B: u moves by dfx / fx (u - cx_A) - 2, v not at all.
+    const rig::CameraModel& lens = rig::sensor(a, "cam_r").camera;
+    const session::ProjectionDifference& p = *c.projection;
+    double max_expected = 0;
+    for (size_t i = 0; i < p.u.size(); ++i) {
+      if (!std::isfinite(p.raw_px[i])) continue;
+      const double expected = std::abs(1.5 / lens.fx * (p.u[i] - lens.cx) - 2.0);
+      EXPECT_NEAR(p.raw_px[i], expected, 1e-6) << p.u[i] << " " << p.v[i];
+      max_expected = std::max(max_expected, expected);
+    }
+    EXPECT_NEAR(p.raw_max_px, max_expected, 1e-6);
+    // The principal point's shift is almost a turn of the camera (about 2 / fx rad); the scale
+    // is not, and what remains is the scale's share.
+    EXPECT_NEAR(p.fitted_rotation_deg, 2.0 / lens.fx / kDeg, 0.3 * 2.0 / lens.fx / kDeg);
+    EXPECT_LT(p.fitted_rms_px, 0.6 * p.raw_rms_px);
+  }
+}
+
+TEST(Diff, SaysWhatItCannotCompare) {
+  rig::Rig a = sample_rig();
+  rig::Rig b = a;
+  rig::sensor(b, "cam_l").camera.width /= 2;
+  b.sensors.erase(std::find_if(b.sensors.begin(), b.sensors.end(),
+                               [](const rig::Sensor& s) { return s.name == "imu"; }));
+  const session::RigDifference d = session::diff_rigs(a, b);
+  EXPECT_EQ(d.only_in_a, std::vector<std::string>{"imu"});
+  for (const session::CameraDifference& c : d.cameras) {
+    if (c.camera != "cam_l") continue;
+    EXPECT_FALSE(c.projection);
+    EXPECT_NE(c.note.find("resolutions differ"), std::string::npos) << c.note;
+  }
+  // Without A's base frame (an import of the cameras alone): compared in A's first sensor that
+  // B has, and said.
+  rig::Rig cameras_only;
+  for (const char* name : {"cam_l", "cam_r"}) cameras_only.sensors.push_back(rig::sensor(a, name));
+  cameras_only.base_frame = "cam_l";
+  const session::RigDifference c = session::diff_rigs(a, cameras_only);
+  EXPECT_EQ(c.base_frame, "cam_l");
+  ASSERT_EQ(c.poses.size(), 1u);
+  EXPECT_LT(c.poses[0].rotation_rad.norm(), 1e-12);  // T_cam_l_cam_r is the same
+  EXPECT_LT(c.poses[0].translation_m.norm(), 1e-12);
+  EXPECT_NE(c.notes.at(0).find("poses compared in 'cam_l'"), std::string::npos) << c.notes[0];
+  rig::Rig other;
+  other.sensors.push_back(rig::sensor(a, "lidar"));
+  other.sensors[0].name = "velodyne";
+  other.base_frame = "velodyne";
+  EXPECT_THROW(session::diff_rigs(a, other), Error);
+}
+
+TEST(DiffCli, WritesItsReportAndRefusesBadInput) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / fmt::format("rigcal_diff_{}", ::getpid());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  rig::Rig a = sample_rig();
+  store_sigmas(a);
+  rig::write_rig_file(a, dir / "a.yaml");
+  rig::Rig b = a;
+  rig::sensor(b, "cam_r").T_base_sensor.t.x() += 0.01;
+  rig::write_rig_file(b, dir / "b.yaml");
+  testing::CliRun r = testing::rigcal_cli(
+      fmt::format("diff {0}/a.yaml {0}/b.yaml --report {0}/report", dir.string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("T_cam_r_lidar"), std::string::npos) << r.out;
+  // 10 mm along one axis against 1.4 mm: chi-square 50 over 6 components.
+  EXPECT_NE(r.out.find(": changed"), std::string::npos) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(testing::slurp(dir / "report/diff.json"));
+  bool found = false;
+  for (const nlohmann::json& p : j["poses"]) {
+    if (p["relation"] != "T_lidar_cam_r") continue;
+    found = true;
+    EXPECT_NEAR(p["translation_mm"][0].get<double>(), 10.0, 1e-9);
+  }
+  EXPECT_TRUE(found);
+  // The map: a point a grid pixel, image rows growing downwards (the first row, v = 0, drawn
+  // above the last).
+  const std::string svg = testing::slurp(dir / "report/projection_diff_cam_l.svg");
+  const auto cy = [&](size_t at) { return std::stod(svg.substr(svg.find("cy=\"", at) + 4)); };
+  EXPECT_LT(cy(svg.find("<circle")), cy(svg.rfind("<circle")));
+  EXPECT_NE(svg.find("|difference| [px]"), std::string::npos);
+  // Another tool's file: Kalibr's camchain (written by rigcal's export) validates, and diffs
+  // against the rigcal file in cam_l's frame (it has no LiDAR), its poses and lenses the same.
+  std::ofstream(dir / "camchain.yaml") << rig::kalibr_camchain_yaml(a);
+  r = testing::rigcal_cli(fmt::format("rig validate {0}/camchain.yaml", dir.string()), dir);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("valid, 3 sensors"), std::string::npos) << r.out;
+  r = testing::rigcal_cli(
+      fmt::format("diff {0}/a.yaml {0}/camchain.yaml --report {0}/kalibr", dir.string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("poses compared in 'cam_l'"), std::string::npos) << r.out;
+  const nlohmann::json k = nlohmann::json::parse(testing::slurp(dir / "kalibr/diff.json"));
+  EXPECT_EQ(k["poses"].size(), 2u);  // cam_r and the IMU in cam_l's frame
+  for (const nlohmann::json& p : k["poses"]) {
+    EXPECT_LT(p["rotation_angle_deg"].get<double>(), 1e-9) << p;
+    EXPECT_LT(p["translation_norm_mm"].get<double>(), 1e-9) << p;
+  }
+  for (const nlohmann::json& c : k["cameras"])
+    EXPECT_LT(c["projection"]["raw_max_px"].get<double>(), 1e-9) << c;
+  EXPECT_EQ(k["only_in_a"].size(), 3u);  // the LiDAR, its IMU, the GNSS/INS
+  // A file that is not a calibration: exit 2, one line naming it.
+  std::ofstream(dir / "bad.yaml") << "cam_l: [1, 2\n";
+  r = testing::rigcal_cli(fmt::format("diff {0}/a.yaml {0}/bad.yaml", dir.string()), dir);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("bad.yaml"), std::string::npos) << r.err;
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rigcal
