@@ -59,8 +59,9 @@ void add_lidar_camera(CLI::App& app);
 // `rigcal calibrate`, `rigcal publish`
 void add_calibrate(CLI::App& app);
 void add_publish(CLI::App& app);
-// `rigcal diff`
+// `rigcal diff`, `rigcal check`
 void add_diff(CLI::App& app);
+void add_check(CLI::App& app);
 // `rigcal convert`
 void add_convert(CLI::App& app);
 // `rigcal odometry`

@@ -64,7 +64,7 @@ void add_diff(CLI::App& app) {
       "cam1 ...; default cam_l, cam_r, or the name the file gives)");
   cmd->add_option("--grid-step", o->grid_step_px, "the projection grid's spacing, px")
       ->capture_default_str()
-      ->check(CLI::Range(1.0, 1000.0));
+      ->check(finite_number(true) & CLI::Range(1.0, 1000.0));
   cmd->callback([o] { run(*o); });
 }
 

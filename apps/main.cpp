@@ -33,10 +33,11 @@ int main(int argc, char** argv) {
   app.footer(
       "Exit status: 0 success, 2 bad input (the message names file, line and key), 1 bug;\n"
       "3 when the data do not determine the answer (time-offset, hand-eye, calibrate,\n"
-      "ground-truth).");
+      "ground-truth), or, for check, when the calibration no longer fits.");
 
   rigcal::cli::add_calibrate(app);
   rigcal::cli::add_publish(app);
+  rigcal::cli::add_check(app);
   rigcal::cli::add_diff(app);
   rigcal::cli::add_convert(app);
   CLI::App* rig = app.add_subcommand("rig", "Check, show and convert a calibration YAML");

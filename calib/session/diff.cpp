@@ -238,12 +238,27 @@ RigDifference diff_rigs(const rig::Rig& a, const rig::Rig& b, const DiffConfig& 
     if (sa.name != out.base_frame) {
       ClockDifference c;
       c.sensor = sa.name;
-      c.offset_s = (sb->time_offset - rb.time_offset) - (sa.time_offset - ra.time_offset);
+      // A drifting clock's offset holds at its epoch: both compared at one instant (B's epoch
+      // where B has a drift, else A's).
+      const Time at = sb->time_drift_ppm ? sb->time_drift_epoch : sa.time_drift_epoch;
+      const auto offset = [&](const rig::Sensor& s) {
+        return s.time_offset + (s.time_drift_ppm
+                                    ? *s.time_drift_ppm * 1e-6 * (at - s.time_drift_epoch).seconds()
+                                    : 0.0);
+      };
+      c.offset_s = (offset(*sb) - offset(rb)) - (offset(sa) - offset(ra));
       auto drift = [](const rig::Sensor& s) { return s.time_drift_ppm.value_or(0.0); };
       if (sa.time_drift_ppm || sb->time_drift_ppm || ra.time_drift_ppm || rb.time_drift_ppm)
         c.drift_ppm = (drift(*sb) - drift(rb)) - (drift(sa) - drift(ra));
-      c.significance =
-          significance({c.offset_s}, {sa.name + ".time_offset_s"}, {1.0}, sigmas_a, sigmas_b);
+      // The offset (s) and, where either has one, the drift (ppm).
+      std::vector<double> values{c.offset_s}, to_si{1.0};
+      std::vector<std::string> keys{sa.name + ".time_offset_s"};
+      if (c.drift_ppm) {
+        values.push_back(*c.drift_ppm);
+        keys.push_back(sa.name + ".time_drift_ppm");
+        to_si.push_back(1.0);
+      }
+      c.significance = significance(values, keys, to_si, sigmas_a, sigmas_b);
       out.clocks.push_back(c);
     }
     if (sa.type == rig::SensorType::camera && sb->type == rig::SensorType::camera)
@@ -302,7 +317,13 @@ nlohmann::json diff_json(const RigDifference& d) {
     clocks.push_back({{"sensor", c.sensor},
                       {"offset_ms", 1e3 * c.offset_s},
                       {"drift_ppm", c.drift_ppm ? nlohmann::json(*c.drift_ppm) : nullptr},
-                      {"significance", significance_json(c.significance, 1e3)}});
+                      {"significance", [&] {
+                         // The offset's sigma in ms, the drift's in ppm.
+                         nlohmann::json j = significance_json(c.significance, 1.0);
+                         if (!j.is_null() && !j["sigma"][0].is_null())
+                           j["sigma"][0] = 1e3 * j["sigma"][0].get<double>();
+                         return j;
+                       }()}});
   }
   for (const CameraDifference& c : d.cameras) {
     nlohmann::json values;

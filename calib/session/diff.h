@@ -40,7 +40,7 @@ struct ClockDifference {
   std::string sensor;
   double offset_s = 0;
   std::optional<double> drift_ppm;           // where either has a drift (none counts as 0)
-  std::optional<Significance> significance;  // of the offset
+  std::optional<Significance> significance;  // of the offset (s), then the drift (ppm)
 };
 
 // The same rays through both lenses, on a grid of pixels of A's image: each pixel's ray by A's

@@ -11,6 +11,7 @@
 #include <functional>
 #include <random>
 
+#include "rigcal/core/error.h"
 #include "rigcal/core/stats.h"
 #include "rigcal/gt/plane_patches.h"
 #include "rigcal/gt/point_to_plane_error.h"

@@ -1,0 +1,46 @@
+// rigcal check (calib/session/check.h) on simulated sessions, the short version of the long
+// test's acceptance: an unchanged rig is consistent, a camera turned by 0.2 deg is flagged on
+// that camera alone; a calibration without step records is refused.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include "check_sim.h"
+
+namespace rigcal {
+namespace {
+
+TEST(CheckSim, AnUnchangedRigIsConsistentAndATurnedCameraIsFlaggedOnItself) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / fmt::format("rigcal_check_{}", ::getpid());
+  fs::remove_all(dir);
+  const std::string config = "stereo:\n  views: 20\nlidar_camera:\n  pairs: 8\n";
+  const std::vector<testing::RigChange> changes = testing::acceptance_changes();
+  const testing::CheckOutcome same = testing::simulated_check(dir, 1, changes[0], config);
+  ASSERT_EQ(same.status, 0) << same.out << same.err;
+  ASSERT_EQ(same.report["verdicts"].size(), 7u) << same.report.dump(1);
+  for (const nlohmann::json& v : same.report["verdicts"])
+    EXPECT_EQ(v["verdict"], "consistent") << v;
+  EXPECT_NE(same.out.find("Verdict: consistent"), std::string::npos) << same.out;
+
+  ASSERT_EQ(changes[1].sensor, "cam_r");
+  const testing::CheckOutcome turned = testing::simulated_check(dir, 1, changes[1], config);
+  EXPECT_EQ(turned.status, 3) << turned.out << turned.err;
+  EXPECT_TRUE(testing::flagged_on(turned, "cam_r")) << turned.out;
+  EXPECT_EQ(turned.report["suspects"], nlohmann::json::array({"cam_r"})) << turned.out;
+  EXPECT_NE(turned.out.find("Changed: cam_r"), std::string::npos) << turned.out;
+  // The difference's figures travel with the verdicts.
+  EXPECT_TRUE(fs::exists(dir / "next/check/diff.json"));
+
+  // A calibration without step records (the bundled sample): nothing to compare, exit 2.
+  const testing::CliRun bare =
+      testing::rigcal_cli(fmt::format("check --rig {}/data/sample_rig.yaml --session {}/next/rec",
+                                      RIGCAL_SOURCE_DIR, dir.string()),
+                          dir);
+  EXPECT_EQ(bare.status, 2);
+  EXPECT_NE(bare.err.find("no step records with sigmas"), std::string::npos) << bare.err;
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rigcal
