@@ -62,6 +62,8 @@ void add_publish(CLI::App& app);
 // `rigcal diff`, `rigcal check`
 void add_diff(CLI::App& app);
 void add_check(CLI::App& app);
+// `rigcal report`
+void add_report(CLI::App& app);
 // `rigcal convert`
 void add_convert(CLI::App& app);
 // `rigcal odometry`

@@ -32,7 +32,7 @@ void run(const Options& o) {
     const std::vector<io::OutputFile> files = session::diff_report_files(d, o.report);
     io::refuse_outputs_over_inputs(files, {{"calibration A", o.a}, {"calibration B", o.b}});
     io::write_files_atomic(files);
-    fmt::print("report: {}/diff.json\n", o.report);
+    fmt::print("report: {0}/report.html, {0}/diff.json\n", o.report);
   }
 }
 

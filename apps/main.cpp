@@ -39,6 +39,7 @@ int main(int argc, char** argv) {
   rigcal::cli::add_publish(app);
   rigcal::cli::add_check(app);
   rigcal::cli::add_diff(app);
+  rigcal::cli::add_report(app);
   rigcal::cli::add_convert(app);
   CLI::App* rig = app.add_subcommand("rig", "Check, show and convert a calibration YAML");
   rig->require_subcommand(1);

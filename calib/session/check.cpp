@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <iterator>
@@ -151,6 +152,9 @@ CheckResult check(const rig::Rig& stored, const std::filesystem::path& stored_fi
         stored_file.string()));
   }
   CheckResult out;
+  out.calibration = stored_file;
+  out.session = options.calibrate.session;
+  out.alarm_p = options.alarm_p;
   CalibrateOptions run = options.calibrate;
   run.rig = stored_file;
   out.estimate = calibrate(run, progress);
@@ -258,8 +262,9 @@ CheckResult check(const rig::Rig& stored, const std::filesystem::path& stored_fi
     out.verdicts.push_back(v);
   }
   // The suspects. A changed relation T_a_b says a or b moved: each sensor of the changed
-  // relations is tried alone (the stored rig with it placed where the most significant changed
-  // relation involving it says), and the one whose rig explains every relation best is named.
+  // relations is tried alone, its move fitted to every judged relation at once (least squares
+  // over their components in their combined sigmas), and the sensor whose move explains them
+  // best is named.
   std::set<std::string> suspects;
   bool any_changed = false;
   std::set<std::string> candidates;
@@ -269,34 +274,63 @@ CheckResult check(const rig::Rig& stored, const std::filesystem::path& stored_fi
     if (v.sensors.size() == 1) suspects.insert(v.sensors[0]);  // a clock, a camera's lens
     if (v.sensors.size() == 2) candidates.insert(v.sensors.begin(), v.sensors.end());
   }
-  for (const std::string& sensor : candidates) {
-    const Verdict* strongest = nullptr;
-    for (const Verdict& v : out.verdicts) {
-      if (v.kind != VerdictKind::changed || v.sensors.size() != 2) continue;
-      if (v.sensors[0] != sensor && v.sensors[1] != sensor) continue;
-      if (!strongest || v.chi2 > strongest->chi2) strongest = &v;
-    }
-    // T_a_b of the re-estimate, with the other sensor where the stored rig has it.
-    const std::string& a = strongest->sensors[0];
-    const std::string& b = strongest->sensors[1];
-    const SE3 T_a_b = rig::T_a_b(estimate, a, b);
-    rig::Rig moved = stored;
-    if (sensor == b) {
-      rig::move_rigidly(moved, b, rig::sensor(stored, a).T_base_sensor * T_a_b);
-    } else {
-      rig::move_rigidly(moved, a, rig::sensor(stored, b).T_base_sensor * T_a_b.inverse());
-    }
-    const RigDifference d = diff_rigs(moved, estimate);
-    Hypothesis h;
-    h.sensor = sensor;
-    for (const Verdict& v : out.verdicts) {
-      if (v.kind == VerdictKind::cannot_tell || v.sensors.size() != 2) continue;
-      for (const PoseDifference& p : d.poses) {
-        if (p.a != v.sensors[0] || p.b != v.sensors[1] || !p.significance) continue;
-        h.chi2 += p.significance->chi2;
-        h.dof += p.significance->dof;
+  // The judged relations with their combined sigmas (rotation rad, then translation m).
+  struct Judged {
+    std::string a, b;
+    std::vector<double> sigma;
+  };
+  std::vector<Judged> judged;
+  for (const Verdict& v : out.verdicts) {
+    if (v.kind == VerdictKind::cannot_tell || v.sensors.size() != 2) continue;
+    for (const PoseDifference& p : out.difference.poses)
+      if (p.a == v.sensors[0] && p.b == v.sensors[1] && p.significance)
+        judged.push_back({p.a, p.b, p.significance->sigma});
+  }
+  // Every judged relation of a rig against the re-estimate's, in sigmas.
+  const auto whitened = [&](const rig::Rig& r) {
+    std::vector<double> out_r;
+    for (const Judged& j : judged) {
+      const SE3 T_p = rig::T_a_b(r, j.a, j.b), T_e = rig::T_a_b(estimate, j.a, j.b);
+      const Eigen::Vector3d rot = rotation_vector(T_e.R * T_p.R.transpose()), t = T_e.t - T_p.t;
+      for (int i = 0; i < 6; ++i) {
+        const double x = i < 3 ? rot[i] : t[i - 3];
+        if (std::isfinite(j.sigma[size_t(i)])) out_r.push_back(x / j.sigma[size_t(i)]);
       }
     }
+    return Eigen::Map<Eigen::VectorXd>(out_r.data(), Eigen::Index(out_r.size())).eval();
+  };
+  for (const std::string& sensor : candidates) {
+    const SE3 T_base_start = rig::sensor(stored, sensor).T_base_sensor;
+    // The sensor moved by (rotation, translation) in the base frame, what is attached with it.
+    const auto moved = [&](const Eigen::Matrix<double, 6, 1>& x) {
+      rig::Rig r = stored;
+      SE3 T = T_base_start;
+      T.R = rotation_from_vector(x.head<3>()) * T.R;
+      T.t += x.tail<3>();
+      rig::move_rigidly(r, sensor, T);
+      return r;
+    };
+    Eigen::Matrix<double, 6, 1> x = Eigen::Matrix<double, 6, 1>::Zero();
+    for (int iteration = 0; iteration < 5; ++iteration) {
+      const Eigen::VectorXd r0 = whitened(moved(x));
+      Eigen::MatrixXd J(r0.size(), 6);
+      for (int k = 0; k < 6; ++k) {
+        Eigen::Matrix<double, 6, 1> xk = x;
+        xk[k] += 1e-7;
+        J.col(k) = (whitened(moved(xk)) - r0) / 1e-7;
+      }
+      // Directions no judged relation sees stay where they are (a small damping).
+      const Eigen::Matrix<double, 6, 6> H =
+          J.transpose() * J + 1e-9 * Eigen::Matrix<double, 6, 6>::Identity();
+      const Eigen::Matrix<double, 6, 1> step = -H.ldlt().solve(J.transpose() * r0);
+      x += step;
+      if (step.norm() < 1e-12) break;
+    }
+    const Eigen::VectorXd r = whitened(moved(x));
+    Hypothesis h;
+    h.sensor = sensor;
+    h.chi2 = r.squaredNorm();
+    h.dof = std::max(1, int(r.size()) - 6);  // the 6 of the move fitted
     h.p_value = chi2_upper_tail(h.chi2, h.dof);
     out.hypotheses.push_back(h);
   }
@@ -335,9 +369,16 @@ nlohmann::json check_json(const CheckResult& r) {
     hypotheses.push_back(
         {{"sensor", h.sensor}, {"chi2", h.chi2}, {"dof", h.dof}, {"p_value", h.p_value}});
   }
-  return {{"verdicts", verdicts},   {"hypotheses", hypotheses},
-          {"suspects", r.suspects}, {"exit_status", r.exit_status},
-          {"steps", steps},         {"difference", diff_json(r.difference)}};
+  return {{"calibration", r.calibration.string()},
+          {"session", r.session.string()},
+          {"tool_version", version_string()},
+          {"alarm_p", r.alarm_p},
+          {"verdicts", verdicts},
+          {"hypotheses", hypotheses},
+          {"suspects", r.suspects},
+          {"exit_status", r.exit_status},
+          {"steps", steps},
+          {"difference", diff_json(r.difference)}};
 }
 
 std::vector<std::string> check_lines(const CheckResult& r) {

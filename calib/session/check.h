@@ -46,16 +46,19 @@ struct Verdict {
   std::string reason;  // cannot tell: why, and what to record
 };
 
-// "This sensor moved, alone": the stored rig with that sensor (and what is attached to it) placed
-// where the most significant changed relation involving it says, every relation then compared
-// with the re-estimate. The one that explains the changed poses best is the suspect.
+// "This sensor moved, alone": the stored rig with that sensor (and what is attached to it) moved
+// by the rotation and translation that best explain every judged relation of the re-estimate
+// (least squares in their combined sigmas); what is left is its chi-square. The sensor that
+// explains the changed poses best is the suspect.
 struct Hypothesis {
   std::string sensor;
-  double chi2 = 0, p_value = 1;  // over every relation with a verdict
-  int dof = 0;
+  double chi2 = 0, p_value = 1;  // over the judged relations' components
+  int dof = 0;                   // those components less the 6 of the fitted move
 };
 
 struct CheckResult {
+  std::filesystem::path calibration, session;  // what was checked against what
+  double alarm_p = 1e-3;
   CalibrateResult estimate;  // the steps on the new session
   RigDifference difference;  // the stored calibration (A) against the re-estimate (B)
   std::vector<Verdict> verdicts;
@@ -79,5 +82,14 @@ CheckResult check(const rig::Rig& stored, const std::filesystem::path& stored_fi
 nlohmann::json check_json(const CheckResult& result);
 // Lines for people: one a quantity, the suspects, the exit status's meaning.
 std::vector<std::string> check_lines(const CheckResult& result);
+
+// The page a person reads (report.html), rendered from check.json alone and the projection maps
+// (`figures`: each map's file name and SVG text), so that `rigcal report DIR` renders it again.
+std::string check_html(const nlohmann::json& check,
+                       const std::vector<std::pair<std::string, std::string>>& figures);
+
+// DIR/report.html rendered again from what a run stored in DIR (check.json, else diff.json, and
+// the projection maps). Throws rigcal::Error when DIR holds neither, or one rigcal did not write.
+io::OutputFile render_report(const std::filesystem::path& dir);
 
 }  // namespace rigcal::session

@@ -436,6 +436,10 @@ std::vector<io::OutputFile> diff_report_files(const RigDifference& d,
     files.push_back(
         {dir / fmt::format("projection_diff_{}.svg", c.camera), report::render_svg(plot)});
   }
+  std::vector<std::pair<std::string, std::string>> figures;
+  for (size_t i = 1; i < files.size(); ++i)
+    figures.emplace_back(files[i].path.filename().string(), files[i].content);
+  files.push_back({dir / "report.html", diff_html(diff_json(d), figures)});
   return files;
 }
 

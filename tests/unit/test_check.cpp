@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include "browser.h"
 #include "check_sim.h"
 
 namespace rigcal {
@@ -29,8 +30,32 @@ TEST(CheckSim, AnUnchangedRigIsConsistentAndATurnedCameraIsFlaggedOnItself) {
   EXPECT_TRUE(testing::flagged_on(turned, "cam_r")) << turned.out;
   EXPECT_EQ(turned.report["suspects"], nlohmann::json::array({"cam_r"})) << turned.out;
   EXPECT_NE(turned.out.find("Changed: cam_r"), std::string::npos) << turned.out;
-  // The difference's figures travel with the verdicts.
+  // The difference's figures travel with the verdicts; the page a person reads holds each
+  // quantity and names the sensor, and renders again from check.json the same.
   EXPECT_TRUE(fs::exists(dir / "next/check/diff.json"));
+  const std::string page = testing::slurp(dir / "next/check/report.html");
+  EXPECT_NE(page.find("Something changed: cam_r"), std::string::npos);
+  for (const nlohmann::json& v : turned.report["verdicts"])
+    EXPECT_NE(page.find(v["quantity"].get<std::string>()), std::string::npos) << v;
+  EXPECT_NE(page.find("Which sensor moved"), std::string::npos);
+  const testing::CliRun again =
+      testing::rigcal_cli(fmt::format("report {}/next/check", dir.string()), dir);
+  EXPECT_EQ(again.status, 0) << again.err;
+  EXPECT_EQ(testing::slurp(dir / "next/check/report.html"), page);
+  if (testing::have_chromium()) {
+    const testing::BrowserLoad load =
+        testing::load_in_browser(dir / "next/check/report.html", dir / "check.png");
+    EXPECT_TRUE(load.ran) << load.log;
+    EXPECT_EQ(testing::console_messages(load.log), "");
+    for (const char* id : {"id=\"verdicts\"", "id=\"which\"", "id=\"steps\"", "id=\"poses\""})
+      EXPECT_NE(load.dom.find(id), std::string::npos) << id;
+    EXPECT_GT(load.screenshot_bytes, 20000u);
+  }
+  for (const nlohmann::json& h : turned.report["hypotheses"]) {
+    std::printf("[ figures ] cam_r turned 0.2 deg, %s moved alone: chi-square %.1f over %d\n",
+                h["sensor"].get<std::string>().c_str(), h["chi2"].get<double>(),
+                h["dof"].get<int>());
+  }
 
   // A calibration without step records (the bundled sample): nothing to compare, exit 2.
   const testing::CliRun bare =

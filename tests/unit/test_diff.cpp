@@ -10,6 +10,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "browser.h"
 #include "cli_run.h"
 #include "rigcal/core/error.h"
 #include "rigcal/core/stats.h"
@@ -253,6 +254,47 @@ TEST(DiffCli, WritesItsReportAndRefusesBadInput) {
   r = testing::rigcal_cli(fmt::format("diff {0}/a.yaml {0}/bad.yaml", dir.string()), dir);
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("bad.yaml"), std::string::npos) << r.err;
+  fs::remove_all(dir);
+}
+
+// The diff's page in a real browser: it loads with no console message, its sections are in the
+// DOM, a screenshot is taken; a page with a script error is caught the same way (the check can
+// fail); `rigcal report DIR` renders the same page again from the stored JSON.
+TEST(DiffReport, LoadsInChromiumAndRendersAgainFromItsJson) {
+  namespace fs = std::filesystem;
+  if (!testing::have_chromium()) GTEST_SKIP() << "chromium (Debian package chromium) not installed";
+  const fs::path dir = fs::temp_directory_path() / fmt::format("rigcal_diff_page_{}", ::getpid());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  rig::Rig a = sample_rig();
+  store_sigmas(a);
+  rig::write_rig_file(a, dir / "a.yaml");
+  rig::Rig b = a;
+  rig::sensor(b, "cam_r").camera.cx += 2.0;
+  rig::write_rig_file(b, dir / "b.yaml");
+  testing::CliRun r = testing::rigcal_cli(
+      fmt::format("diff {0}/a.yaml {0}/b.yaml --report {0}/report", dir.string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string page = testing::slurp(dir / "report/report.html");
+  const testing::BrowserLoad load =
+      testing::load_in_browser(dir / "report/report.html", dir / "shot.png");
+  EXPECT_TRUE(load.ran) << load.log;
+  EXPECT_EQ(testing::console_messages(load.log), "");
+  for (const char* id : {"id=\"poses\"", "id=\"clocks\"", "id=\"cameras\"", "<svg"})
+    EXPECT_NE(load.dom.find(id), std::string::npos) << id;
+  EXPECT_GT(load.screenshot_bytes, 20000u);
+  std::ofstream(dir / "bad.html") << "<!doctype html><p>x</p><script>undefined_fn();</script>";
+  const testing::BrowserLoad bad = testing::load_in_browser(dir / "bad.html", dir / "bad.png");
+  EXPECT_NE(testing::console_messages(bad.log).find("Uncaught ReferenceError"), std::string::npos)
+      << bad.log;
+  // Rendered again from diff.json and the maps: the same page.
+  fs::remove(dir / "report/report.html");
+  r = testing::rigcal_cli(fmt::format("report {}/report", dir.string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(testing::slurp(dir / "report/report.html"), page);
+  r = testing::rigcal_cli(fmt::format("report {}", dir.string()), dir);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("no check.json or diff.json"), std::string::npos) << r.err;
   fs::remove_all(dir);
 }
 

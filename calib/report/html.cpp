@@ -1,0 +1,89 @@
+// A self-contained HTML page (html.h).
+#include "rigcal/report/html.h"
+
+#include <fmt/format.h>
+
+namespace rigcal::report {
+
+std::string html_escape(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char c : text) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&#39;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+std::string html_table(const std::vector<std::string>& header,
+                       const std::vector<std::vector<std::string>>& rows,
+                       const std::vector<std::string>& classes) {
+  std::string out = "<table>\n<thead><tr>";
+  for (const std::string& h : header) out += "<th>" + html_escape(h) + "</th>";
+  out += "</tr></thead>\n<tbody>\n";
+  for (size_t r = 0; r < rows.size(); ++r) {
+    const std::string cls = r < classes.size() && !classes[r].empty()
+                                ? fmt::format(" class=\"{}\"", html_escape(classes[r]))
+                                : "";
+    out += "<tr" + cls + ">";
+    for (const std::string& cell : rows[r]) out += "<td>" + cell + "</td>";
+    out += "</tr>\n";
+  }
+  return out + "</tbody>\n</table>\n";
+}
+
+std::string html_badge(std::string_view verdict) {
+  const std::string_view kind = verdict == "consistent" || verdict == "ok"    ? "good"
+                                : verdict == "changed" || verdict == "failed" ? "bad"
+                                                                              : "unsure";
+  return fmt::format("<span class=\"badge {}\">{}</span>", kind, html_escape(verdict));
+}
+
+std::string html_page(std::string_view title, std::string_view body) {
+  return fmt::format(
+      "<!doctype html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+      "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
+      "<title>{}</title>\n<style>\n"
+      "body {{ font-family: sans-serif; margin: 2em auto; max-width: 1100px; color: #222; "
+      "line-height: 1.4; }}\n"
+      "h1 {{ font-size: 1.6em; }} h2 {{ font-size: 1.25em; margin-top: 1.8em; border-bottom: 1px "
+      "solid #ccc; }}\n"
+      "table {{ border-collapse: collapse; margin: 0.6em 0; font-size: 0.92em; }}\n"
+      "th, td {{ border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: left; "
+      "vertical-align: top; }}\n"
+      "th {{ background: #f2f2f2; }}\n"
+      "td.num {{ text-align: right; font-variant-numeric: tabular-nums; }}\n"
+      ".badge {{ padding: 0.1em 0.5em; border-radius: 0.6em; font-weight: bold; white-space: "
+      "nowrap; }}\n"
+      ".good {{ background: #d7f2d7; color: #185c18; }} .bad {{ background: #f8d4d4; color: "
+      "#8a1616; }} .unsure {{ background: #fbeccc; color: #7a5200; }}\n"
+      ".headline {{ font-size: 1.25em; padding: 0.6em 0.9em; border-radius: 0.4em; }}\n"
+      ".note {{ color: #555; font-size: 0.9em; }}\n"
+      "figure {{ margin: 1em 0; }} figcaption {{ color: #555; font-size: 0.9em; }}\n"
+      "</style>\n</head>\n<body>\n{}\n</body>\n</html>\n",
+      html_escape(title), body);
+}
+
+std::string html_inline_svg(std::string_view svg) {
+  const size_t start = svg.find("<svg");
+  return std::string(start == std::string_view::npos ? svg : svg.substr(start));
+}
+
+}  // namespace rigcal::report

@@ -1,0 +1,30 @@
+#pragma once
+// A self-contained HTML page for reports a person reads (doc/check.md, "The report"): one file,
+// its style inline, its figures inline SVG, no script, nothing fetched. Built from the steps'
+// saved JSON and figures, so `rigcal report DIR` renders it again from what a run stored.
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace rigcal::report {
+
+// Text as HTML (& < > " ').
+std::string html_escape(std::string_view text);
+
+// A table: a header row, then rows of cells that are HTML already (escape text first).
+// `classes`: a CSS class a row ("" for none), as long as `rows` or empty.
+std::string html_table(const std::vector<std::string>& header,
+                       const std::vector<std::vector<std::string>>& rows,
+                       const std::vector<std::string>& classes = {});
+
+// A verdict as a coloured badge: "consistent" and "ok" green, "changed", "failed" red, others
+// (cannot tell, undetermined, blocked) amber.
+std::string html_badge(std::string_view verdict);
+
+// The whole page: <!doctype html>, the title, the style, `body`.
+std::string html_page(std::string_view title, std::string_view body);
+
+// An SVG file's text ready to sit inline in a page (its XML declaration dropped).
+std::string html_inline_svg(std::string_view svg);
+
+}  // namespace rigcal::report
