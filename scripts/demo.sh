@@ -62,6 +62,11 @@ echo "== the calibration against the truth (data/sample_rig.yaml)"
 "$rigcal" rig show "$out/session/calib.yaml" | sed -n '1,12p'
 echo "true: cam_l fx 1085.3 fy 1084.7 cx 701.2 cy 349.6; baseline 0.4985 m; imu and gnss offsets"
 echo "-3.1 ms; gnss at [-0.0512 0.0034 -0.1395] m (data/sample_rig.yaml)"
+echo
+echo "== rigcal diff: the truth against the calibration, weighed by the calibration's sigmas"
+echo "   (the page a person reads: $out/diff/report.html)"
+"$rigcal" diff "$out/sim/truth.yaml" "$out/session/calib.yaml" --report "$out/diff" | \
+  grep -E "^Poses|T_cam_r_cam_l|T_cam_r_lidar|T_gnss_lidar|^Camera|the same rays|report:"
 
 echo
 echo "== a rerun with unchanged inputs reuses every step"
