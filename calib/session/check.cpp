@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <set>
 
@@ -336,7 +337,12 @@ CheckResult check(const rig::Rig& stored, const std::filesystem::path& stored_fi
   }
   std::sort(out.hypotheses.begin(), out.hypotheses.end(),
             [](const Hypothesis& x, const Hypothesis& y) { return x.chi2 < y.chi2; });
-  if (!out.hypotheses.empty()) suspects.insert(out.hypotheses.front().sensor);
+  if (!out.hypotheses.empty()) {
+    suspects.insert(out.hypotheses.front().sensor);
+    out.likelihood_ratio = out.hypotheses.size() == 1
+                               ? std::numeric_limits<double>::infinity()
+                               : std::exp(0.5 * (out.hypotheses[1].chi2 - out.hypotheses[0].chi2));
+  }
   out.suspects.assign(suspects.begin(), suspects.end());
   const int run_status = out.estimate.exit_status;
   out.exit_status = any_changed ? 3 : (run_status == 1 || run_status == 2) ? run_status : 0;
@@ -376,6 +382,8 @@ nlohmann::json check_json(const CheckResult& r) {
           {"verdicts", verdicts},
           {"hypotheses", hypotheses},
           {"suspects", r.suspects},
+          {"likelihood_ratio",
+           std::isfinite(r.likelihood_ratio) ? nlohmann::json(r.likelihood_ratio) : nullptr},
           {"exit_status", r.exit_status},
           {"steps", steps},
           {"difference", diff_json(r.difference)}};
@@ -404,6 +412,12 @@ std::vector<std::string> check_lines(const CheckResult& r) {
         "Which sensor moved: each sensor of the changed relations moved alone, every relation "
         "against the re-estimate: {}",
         fmt::join(tried, "; ")));
+    if (r.hypotheses.size() > 1) {
+      out.push_back(
+          fmt::format("  {} moving alone is {:.3g} times as likely as {} moving alone{}",
+                      r.hypotheses[0].sensor, r.likelihood_ratio, r.hypotheses[1].sensor,
+                      r.likelihood_ratio < 20 ? ": the data barely tell them apart" : ""));
+    }
     if (r.hypotheses.front().p_value < 1e-3) {
       out.push_back(
           fmt::format("  no single sensor moving explains the changes ({} does best): "

@@ -64,6 +64,10 @@ struct CheckResult {
   std::vector<Verdict> verdicts;
   // Where a relation changed: each sensor of the changed relations, moved alone, best first.
   std::vector<Hypothesis> hypotheses;
+  // How much likelier the best hypothesis is than the next, exp((chi2_2 - chi2_1) / 2) (infinite
+  // with one hypothesis): near 1 the data barely tell the two sensors apart (the stereo
+  // extrinsic alone cannot say which camera turned).
+  double likelihood_ratio = 0;
   // The sensors that changed: the best hypothesis's sensor for the poses, the sensors of changed
   // clocks and intrinsics.
   std::vector<std::string> suspects;

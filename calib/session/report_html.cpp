@@ -173,6 +173,14 @@ std::string check_html(const nlohmann::json& c, const Figures& figures) {
                       num(h["p_value"], "{:.3g}")});
     }
     body += report::html_table({"moved alone", "chi² / dof", "p"}, rows);
+    if (c["hypotheses"].size() > 1 && c["likelihood_ratio"].is_number()) {
+      const double ratio = c["likelihood_ratio"];
+      body +=
+          fmt::format("<p>{} moving alone is {:.3g} times as likely as {} moving alone{}.</p>\n",
+                      html_escape(c["hypotheses"][0]["sensor"].get<std::string>()), ratio,
+                      html_escape(c["hypotheses"][1]["sensor"].get<std::string>()),
+                      ratio < 20 ? ": the data barely tell them apart" : "");
+    }
   }
   body += "<h2 id=\"steps\">The steps on the new session</h2>\n";
   rows.clear();

@@ -46,10 +46,14 @@ TEST(CheckSimLong, TwentySeedsOfEachChange) {
                           : o.status == 3 && suspects == std::vector<std::string>{change.sensor};
       alone[change.name] += among;
       right[change.name] += ok;
-      std::printf("[ figures ] seed %d, %s: exit %d, suspects [%s], not consistent: [%s]\n",
-                  int(seed), change.name.c_str(), o.status,
-                  fmt::format("{}", fmt::join(suspects, ", ")).c_str(),
-                  fmt::format("{}", fmt::join(flagged, "; ")).c_str());
+      const nlohmann::json& ratio = o.report["likelihood_ratio"];
+      std::printf(
+          "[ figures ] seed %d, %s: exit %d, suspects [%s]%s, not consistent: [%s]\n", int(seed),
+          change.name.c_str(), o.status, fmt::format("{}", fmt::join(suspects, ", ")).c_str(),
+          ratio.is_number()
+              ? fmt::format(" ({:.3g} times as likely as the next)", ratio.get<double>()).c_str()
+              : "",
+          fmt::format("{}", fmt::join(flagged, "; ")).c_str());
       std::fflush(stdout);
     }
     fs::remove_all(dir);

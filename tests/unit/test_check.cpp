@@ -29,6 +29,9 @@ TEST(CheckSim, AnUnchangedRigIsConsistentAndATurnedCameraIsFlaggedOnItself) {
   EXPECT_EQ(turned.status, 3) << turned.out << turned.err;
   EXPECT_TRUE(testing::flagged_on(turned, "cam_r")) << turned.out;
   EXPECT_EQ(turned.report["suspects"], nlohmann::json::array({"cam_r"})) << turned.out;
+  // Named with how much likelier than cam_l it is (only T_cam_r_lidar tells the two apart).
+  EXPECT_GT(turned.report["likelihood_ratio"].get<double>(), 1.0);
+  EXPECT_NE(turned.out.find("cam_r moving alone is"), std::string::npos) << turned.out;
   EXPECT_NE(turned.out.find("Changed: cam_r"), std::string::npos) << turned.out;
   // The difference's figures travel with the verdicts; the page a person reads holds each
   // quantity and names the sensor, and renders again from check.json the same.
