@@ -45,15 +45,7 @@ void run(const Options& o) {
   }
   for (const std::string& line : session::check_lines(r)) fmt::print("{}\n", line);
   if (keep) {
-    // The difference's files, its page replaced by the check's.
-    std::vector<io::OutputFile> files = session::diff_report_files(r.difference, o.report);
-    std::vector<std::pair<std::string, std::string>> figures;
-    for (const io::OutputFile& f : files)
-      if (f.path.extension() == ".svg") figures.emplace_back(f.path.filename().string(), f.content);
-    const nlohmann::json check = session::check_json(r);
-    for (io::OutputFile& f : files)
-      if (f.path.filename() == "report.html") f.content = session::check_html(check, figures);
-    files.push_back({fs::path(o.report) / "check.json", check.dump(2) + "\n"});
+    const std::vector<io::OutputFile> files = session::check_report_files(r, o.report);
     io::refuse_outputs_over_inputs(files, {{"the calibration", o.rig}, {"the session", o.session}});
     io::write_files_atomic(files);
     fmt::print("report: {0}/report.html, {0}/check.json (the re-estimate's own reports in {1})\n",

@@ -5,14 +5,9 @@
 #include <memory>
 
 #include "cli.h"
-#include "rigcal/core/error.h"
 #include "rigcal/core/text.h"
 #include "rigcal/gt/step.h"
 #include "rigcal/io/files.h"
-#include "rigcal/io/ground_truth_io.h"
-#include "rigcal/io/odometry_io.h"
-#include "rigcal/io/trajectory_io.h"
-#include "rigcal/rig/rig_yaml.h"
 #include "step_output.h"
 
 namespace rigcal::cli {
@@ -20,53 +15,26 @@ namespace ground_truth_command {
 namespace fs = std::filesystem;
 
 struct Options {
-  std::string recording, rig, out, sigmas, odometry, covariances, gnss, report, scans, map, markers;
-  double map_voxel_m = gt::MapConfig{}.voxel_size_m, marker_intensity = 0;
-  std::string gnss_sensor = "gnss", odometry_preset, enu_origin;
-  double max_fix_gap_s = 0.5;
-  std::string fix_correlation = "auto";
-  bool no_bundle_adjustment = false, photometric = false, no_fusion = false;
-  size_t window_scans = gt::SequenceBaConfig{}.window_scans;
-  size_t window_overlap = gt::SequenceBaConfig{}.overlap_scans;
+  gt::InputFiles in;
+  gt::StepOptions step;
+  std::string out, sigmas, report, map, enu_origin, fix_correlation = "auto";
+  bool no_bundle_adjustment = false, no_fusion = false;
   std::pair<size_t, size_t> windows{0, 0};  // FROM:TO; 0:0 all
-  std::vector<std::string> window_motions;
 };
 
-void run(const Options& o) {
-  gt::StepInputs in;
-  in.rig = rig::read_rig_file(o.rig);
-  in.rig_source = o.rig;
-  in.gnss = o.gnss.empty() ? gt::default_gnss(o.recording) : fs::path(o.gnss);
-  in.scans = gt::scans_of(o.recording, o.scans, !o.odometry.empty(),
-                          !o.no_bundle_adjustment || !o.map.empty() || !o.markers.empty(),
-                          console_progress());
-  if (!o.odometry.empty()) in.odometry = o.odometry, in.covariances = o.covariances;
-  gt::StepOptions options;
-  options.gnss_sensor = o.gnss_sensor;
+void run(Options o) {
+  o.step.bundle_adjustment = !o.no_bundle_adjustment;
+  o.step.fuse_odometry = !o.no_fusion;
+  o.step.map = !o.map.empty();
   if (!o.enu_origin.empty())
-    options.enu_origin = io::parse_geodetic_origin(o.enu_origin, "--enu-origin");
-  options.odometry_preset = o.odometry_preset;
-  options.pose_graph.max_fix_gap_s = o.max_fix_gap_s;
-  options.pose_graph.fix_correlation_s =
+    o.step.enu_origin = io::parse_geodetic_origin(o.enu_origin, "--enu-origin");
+  o.step.pose_graph.fix_correlation_s =
       o.fix_correlation == "auto" ? -1.0 : parse_double(o.fix_correlation, "--fix-correlation");
-  options.bundle_adjustment = !o.no_bundle_adjustment;
-  options.ba.window_scans = o.window_scans;
-  options.ba.overlap_scans = o.window_overlap;
-  options.ba.window.photometric.enabled = o.photometric;
   if (o.windows != std::pair<size_t, size_t>{0, 0})
-    std::tie(options.ba.first_window, options.ba.end_window) = o.windows;
-  for (const std::string& f : o.window_motions) in.window_motions.push_back(f);
-  options.fuse_odometry = !o.no_fusion;
-  options.map = !o.map.empty();
-  options.map_config.voxel_size_m = o.map_voxel_m;
-  options.map_config.bright_intensity = o.marker_intensity;
-  if (!o.markers.empty()) {
-    in.markers = io::read_marker_survey(o.markers);
-    in.markers_file = o.markers;
-  }
+    std::tie(o.step.ba.first_window, o.step.ba.end_window) = o.windows;
+  const gt::StepInputs in = gt::step_inputs(o.in, o.step, console_progress());
   const gt::GroundTruthPaths paths = gt::ground_truth_paths(o.out, o.sigmas, o.report, o.map, in);
-
-  const gt::GroundTruthRun run = gt::run_ground_truth(in, options, console_progress());
+  const gt::GroundTruthRun run = gt::run_ground_truth(in, o.step, console_progress());
   const gt::PoseGraphResult& g = run.graph;
   const nlohmann::json report = gt::ground_truth_report(run, in);
   fmt::print("{}", gt::ground_truth_summary(run, report));
@@ -107,31 +75,32 @@ void add_ground_truth(CLI::App& app) {
       "something undetermined (said on stderr). A job array (doc/performance.md): each task\n"
       "runs --windows FROM:TO (OUT: its motions), then one run joins them with\n"
       "--window-motions.");
-  cmd->add_option("recording", o->recording,
+  cmd->add_option("recording", o->in.recording,
                   "the recording: its gnss/ (poses.tum, fixes.csv or navsat.csv) and its scans "
                   "(ouster_points/, a capture, a session): the odometry's without --odometry, "
                   "the bundle adjustment's")
       ->required();
-  cmd->add_option("--rig", o->rig, "the calibration: the GNSS sensor's T_b and time_offset")
+  cmd->add_option("--rig", o->in.rig, "the calibration: the GNSS sensor's T_b and time_offset")
       ->required();
   cmd->add_option("--out", o->out, "output trajectory (VBR ground-truth format)")->required();
   cmd->add_option("--sigmas", o->sigmas,
                   "output per-pose standard deviations (default: OUT without extension + "
                   "_sigmas.txt)");
-  cmd->add_option("--odometry", o->odometry,
+  cmd->add_option("--odometry", o->in.odometry,
                   "an odometry trajectory (T_odom_lidar) instead of running rigcal's on the scans");
-  cmd->add_option("--covariances", o->covariances,
+  cmd->add_option("--covariances", o->in.covariances,
                   "its step covariances (default: ODOMETRY without extension + _covariances.txt)");
-  cmd->add_option("--gnss", o->gnss, "GNSS/INS poses (TUM, T_enu_gnss) or fixes (CSV)");
-  cmd->add_option("--gnss-sensor", o->gnss_sensor, "the rig's GNSS sensor")->capture_default_str();
+  cmd->add_option("--gnss", o->in.gnss, "GNSS/INS poses (TUM, T_enu_gnss) or fixes (CSV)");
+  cmd->add_option("--gnss-sensor", o->step.gnss_sensor, "the rig's GNSS sensor")
+      ->capture_default_str();
   cmd->add_option("--enu-origin", o->enu_origin,
                   "LAT,LON,HEIGHT (degrees, degrees, ellipsoidal m): the fixes' ENU frame at this "
                   "origin instead of at the first fix (sessions that must share one frame; fixes "
                   "only, not GNSS/INS poses)");
-  cmd->add_option("--odometry-preset", o->odometry_preset,
+  cmd->add_option("--odometry-preset", o->step.odometry_preset,
                   "rigcal's odometry preset (default: the rig LiDAR's model)")
       ->check(CLI::IsMember(lidar::preset_names()));
-  cmd->add_option("--max-fix-gap", o->max_fix_gap_s,
+  cmd->add_option("--max-fix-gap", o->step.pose_graph.max_fix_gap_s,
                   "a scan gets a prior from the fixes around it when they are at most this far "
                   "apart, s")
       ->check(seconds_within(1e-6, 60))
@@ -142,7 +111,7 @@ void add_ground_truth(CLI::App& app) {
                   "residuals of the solves, each solved again with it until it settles)")
       ->check(CLI::IsMember({"auto"}) | seconds_within(0, 600))
       ->capture_default_str();
-  cmd->add_option("--scans", o->scans,
+  cmd->add_option("--scans", o->in.scans,
                   "the scans (a folder, a capture, a recording; default: the recording's)");
   cmd->add_flag("--no-bundle-adjustment", o->no_bundle_adjustment,
                 "stop at the pose graph (stage 1)");
@@ -150,14 +119,14 @@ void add_ground_truth(CLI::App& app) {
                 "take the bundle adjustment's motions alone into the second pose graph (default: "
                 "each fused with the odometry's by covariance intersection where the two agree "
                 "within their covariances)");
-  cmd->add_flag("--photometric", o->photometric,
+  cmd->add_flag("--photometric", o->step.ba.window.photometric.enabled,
                 "add the photometric term to each window (range and intensity between the "
                 "scans' spherical images, after the geometric rounds; doc/ground-truth.md "
                 "measures what it adds)");
-  cmd->add_option("--window-scans", o->window_scans, "scans a bundle-adjustment window")
+  cmd->add_option("--window-scans", o->step.ba.window_scans, "scans a bundle-adjustment window")
       ->check(CLI::Range(size_t(2), size_t(1000)))
       ->capture_default_str();
-  cmd->add_option("--window-overlap", o->window_overlap,
+  cmd->add_option("--window-overlap", o->step.ba.overlap_scans,
                   "scans each window shares with the previous one")
       ->check(CLI::Range(size_t(0), size_t(999)))
       ->capture_default_str();
@@ -166,21 +135,21 @@ void add_ground_truth(CLI::App& app) {
                   "the motions they own to OUT (TUM) and OUT's _covariances.txt, nothing else: "
                   "one task of a job array (the same odometry, GNSS and options in every task)")
       ->delimiter(':');
-  cmd->add_option("--window-motions", o->window_motions,
+  cmd->add_option("--window-motions", o->in.window_motions,
                   "the motions the tasks of --windows wrote (all of them, any order): joined in "
                   "place of the bundle adjustment, then the pose graph as usual")
       ->check(CLI::ExistingFile);
   cmd->add_option("--map", o->map,
                   "output map: the scans placed by the ground truth, one point a voxel (binary "
                   "PLY: x y z intensity, the ENU frame)");
-  cmd->add_option("--map-voxel", o->map_voxel_m, "the map's voxel, m")
+  cmd->add_option("--map-voxel", o->step.map_config.voxel_size_m, "the map's voxel, m")
       ->check(CLI::Range(0.01, 10.0))
       ->capture_default_str();
-  cmd->add_option("--markers", o->markers,
+  cmd->add_option("--markers", o->in.markers,
                   "survey markers to check the map against (CSV: id,x,y,z in any frame, or "
                   "id_a,id_b,distance in m): found as clusters of bright points, their distances "
                   "compared with the survey's");
-  cmd->add_option("--marker-intensity", o->marker_intensity,
+  cmd->add_option("--marker-intensity", o->step.map_config.bright_intensity,
                   "the intensity a marker's points reach (default: 10x the first scan's median)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--report", o->report,

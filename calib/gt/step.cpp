@@ -17,6 +17,7 @@
 #include "rigcal/io/odometry_io.h"
 #include "rigcal/io/trajectory_io.h"
 #include "rigcal/report/json.h"
+#include "rigcal/rig/rig_yaml.h"
 
 namespace rigcal::gt {
 namespace fs = std::filesystem;
@@ -589,6 +590,23 @@ fs::path scans_of(const fs::path& recording, const fs::path& given, bool odometr
   } catch (const Error&) {
     return {};
   }
+}
+
+StepInputs step_inputs(const InputFiles& files, const StepOptions& options,
+                       const report::Progress& progress) {
+  StepInputs in;
+  in.rig = rig::read_rig_file(files.rig);
+  in.rig_source = files.rig.string();
+  in.gnss = files.gnss.empty() ? default_gnss(files.recording) : files.gnss;
+  in.scans = scans_of(files.recording, files.scans, !files.odometry.empty(),
+                      options.bundle_adjustment || options.map || !files.markers.empty(), progress);
+  if (!files.odometry.empty()) in.odometry = files.odometry, in.covariances = files.covariances;
+  if (!files.markers.empty()) {
+    in.markers = io::read_marker_survey(files.markers);
+    in.markers_file = files.markers;
+  }
+  in.window_motions = files.window_motions;
+  return in;
 }
 
 GroundTruthPaths ground_truth_paths(const fs::path& out, const fs::path& sigmas,

@@ -144,6 +144,17 @@ std::filesystem::path scans_of(const std::filesystem::path& recording,
                                const std::filesystem::path& given, bool odometry_given, bool wanted,
                                const report::Progress& progress = {});
 
+// The files a `rigcal ground-truth` run names (empty: not given).
+struct InputFiles {
+  std::filesystem::path recording, rig, gnss, scans, odometry, covariances, markers;
+  std::vector<std::filesystem::path> window_motions;
+};
+// A run's inputs from the files it names: the rig read, the GNSS file (default_gnss when none),
+// the scans (scans_of: wanted by the bundle adjustment, the map or the markers of `options`
+// and `files`), the odometry with its covariances, the markers' survey, the chunks' motions.
+StepInputs step_inputs(const InputFiles& files, const StepOptions& options,
+                       const report::Progress& progress = {});
+
 // A run's outputs: `out`, its sigmas (`sigmas`, or OUT without extension + _sigmas.txt), the
 // report in `report_dir` (ground_truth.json; none when empty), the map. Throws rigcal::Error
 // when one of them is one of the inputs.

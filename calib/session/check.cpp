@@ -11,6 +11,7 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <tuple>
 
 #include "rigcal/core/error.h"
 #include "rigcal/core/stats.h"
@@ -81,15 +82,10 @@ std::vector<Quantity> quantities(const std::vector<StepRecord>& records, const r
       q.step = r.step;
       if (key.rfind("T_", 0) == 0) {
         const std::string frames = key.substr(2, key.find('.') - 2);
-        for (size_t cut = frames.find('_'); cut != std::string::npos;
-             cut = frames.find('_', cut + 1)) {
-          if (rig::find_sensor(stored, frames.substr(0, cut)) &&
-              rig::find_sensor(stored, frames.substr(cut + 1))) {
-            q.a = frames.substr(0, cut), q.b = frames.substr(cut + 1);
-            break;
-          }
-        }
-        if (q.a.empty()) continue;
+        const std::optional<std::pair<std::string, std::string>> ab =
+            relation_sensors(frames, stored);
+        if (!ab) continue;
+        std::tie(q.a, q.b) = *ab;
         q.name = "T_" + frames;
         q.kind = Quantity::pose;
       } else if (const size_t dot = key.find('.'); dot != std::string::npos) {
@@ -117,13 +113,6 @@ std::vector<Quantity> quantities(const std::vector<StepRecord>& records, const r
       existing->keys.push_back(key);
     }
   }
-  return out;
-}
-
-std::map<std::string, double> sigmas_of(const rig::Rig& rig) {
-  std::map<std::string, double> out;
-  for (const StepRecord& r : read_steps(rig))
-    for (const report::Figure& f : r.sigmas) out[f.name] = f.value;
   return out;
 }
 
@@ -171,7 +160,8 @@ CheckResult check(const rig::Rig& stored, const std::filesystem::path& stored_fi
   std::erase_if(meta, [](const auto& kv) { return kv.first == "steps"; });
   meta.emplace_back("steps", steps_yaml(new_records));
   out.difference = diff_rigs(stored, estimate);
-  const std::map<std::string, double> sigmas_a = sigmas_of(stored), sigmas_b = sigmas_of(estimate);
+  const std::map<std::string, double> sigmas_a = stored_sigmas(stored),
+                                      sigmas_b = stored_sigmas(estimate);
 
   for (const Quantity& q : stored_quantities) {
     Verdict v;
@@ -430,6 +420,17 @@ std::vector<std::string> check_lines(const CheckResult& r) {
                 : r.exit_status == 0 ? "Verdict: consistent where the new data can tell (exit 0)"
                                      : "Verdict: a step failed on the new session (see above)");
   return out;
+}
+
+std::vector<io::OutputFile> check_report_files(const CheckResult& r,
+                                               const std::filesystem::path& dir) {
+  const nlohmann::json check = check_json(r);
+  const std::vector<std::pair<std::string, std::string>> maps = projection_maps(r.difference);
+  std::vector<io::OutputFile> files{{dir / "check.json", check.dump(2) + "\n"},
+                                    {dir / "diff.json", check["difference"].dump(2) + "\n"},
+                                    {dir / "report.html", check_html(check, maps)}};
+  for (const auto& [name, svg] : maps) files.push_back({dir / name, svg});
+  return files;
 }
 
 }  // namespace rigcal::session

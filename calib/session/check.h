@@ -92,6 +92,10 @@ std::vector<std::string> check_lines(const CheckResult& result);
 std::string check_html(const nlohmann::json& check,
                        const std::vector<std::pair<std::string, std::string>>& figures);
 
+// The report of a check in `dir`: check.json, diff.json, the projection maps, report.html.
+std::vector<io::OutputFile> check_report_files(const CheckResult& result,
+                                               const std::filesystem::path& dir);
+
 // DIR/report.html rendered again from what a run stored in DIR (check.json, else diff.json, and
 // the projection maps). Throws rigcal::Error when DIR holds neither, or one rigcal did not write.
 io::OutputFile render_report(const std::filesystem::path& dir);

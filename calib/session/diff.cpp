@@ -22,14 +22,6 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-// Every 1-sigma a calibration's steps stored, by the key it was written under.
-std::map<std::string, double> stored_sigmas(const rig::Rig& rig) {
-  std::map<std::string, double> out;
-  for (const StepRecord& s : read_steps(rig))
-    for (const report::Figure& f : s.sigmas) out[f.name] = f.value;
-  return out;
-}
-
 // The significance of `difference` against the sigmas stored under `keys` (each scaled by
 // `to_si` to the difference's units) in A and in B; none when neither stores any of them.
 std::optional<Significance> significance(const std::vector<double>& difference,
@@ -91,20 +83,26 @@ std::vector<std::pair<std::string, std::string>> stored_relations(
   for (const auto& [name, value] : sigmas) {
     std::smatch m;
     if (!std::regex_match(name, m, key)) continue;
-    const std::string frames = m[1];
-    // "cam_r_lidar": the split whose two parts are sensors of both rigs.
-    for (size_t cut = frames.find('_'); cut != std::string::npos; cut = frames.find('_', cut + 1)) {
-      const std::string first = frames.substr(0, cut), second = frames.substr(cut + 1);
-      if (!rig::find_sensor(a, first) || !rig::find_sensor(a, second) ||
-          !rig::find_sensor(b, first) || !rig::find_sensor(b, second))
-        continue;
-      if (std::find(out.begin(), out.end(), std::pair{first, second}) == out.end())
-        out.emplace_back(first, second);
-      break;
-    }
+    const std::optional<std::pair<std::string, std::string>> ab = relation_sensors(m[1].str(), a);
+    if (!ab || !rig::find_sensor(b, ab->first) || !rig::find_sensor(b, ab->second)) continue;
+    if (std::find(out.begin(), out.end(), *ab) == out.end()) out.push_back(*ab);
   }
   return out;
 }
+
+}  // namespace
+
+std::optional<std::pair<std::string, std::string>> relation_sensors(std::string_view frames,
+                                                                    const rig::Rig& rig) {
+  for (size_t cut = frames.find('_'); cut != std::string_view::npos;
+       cut = frames.find('_', cut + 1)) {
+    const std::string a(frames.substr(0, cut)), b(frames.substr(cut + 1));
+    if (rig::find_sensor(rig, a) && rig::find_sensor(rig, b)) return std::pair{a, b};
+  }
+  return std::nullopt;
+}
+
+namespace {
 
 Eigen::Vector3d ray(const Eigen::Vector2d& xn) { return Eigen::Vector3d(xn.x(), xn.y(), 1.0); }
 
@@ -410,9 +408,8 @@ std::vector<std::string> diff_lines(const RigDifference& d) {
   return out;
 }
 
-std::vector<io::OutputFile> diff_report_files(const RigDifference& d,
-                                              const std::filesystem::path& dir) {
-  std::vector<io::OutputFile> files{{dir / "diff.json", diff_json(d).dump(2) + "\n"}};
+std::vector<std::pair<std::string, std::string>> projection_maps(const RigDifference& d) {
+  std::vector<std::pair<std::string, std::string>> maps;
   for (const CameraDifference& c : d.cameras) {
     if (!c.projection) continue;
     const ProjectionDifference& p = *c.projection;
@@ -433,13 +430,18 @@ std::vector<io::OutputFile> diff_report_files(const RigDifference& d,
       points.values.push_back(p.fitted_px[i]);
     }
     plot.series.push_back(std::move(points));
-    files.push_back(
-        {dir / fmt::format("projection_diff_{}.svg", c.camera), report::render_svg(plot)});
+    maps.emplace_back(fmt::format("projection_diff_{}.svg", c.camera), report::render_svg(plot));
   }
-  std::vector<std::pair<std::string, std::string>> figures;
-  for (size_t i = 1; i < files.size(); ++i)
-    figures.emplace_back(files[i].path.filename().string(), files[i].content);
-  files.push_back({dir / "report.html", diff_html(diff_json(d), figures)});
+  return maps;
+}
+
+std::vector<io::OutputFile> diff_report_files(const RigDifference& d,
+                                              const std::filesystem::path& dir) {
+  const nlohmann::json j = diff_json(d);
+  const std::vector<std::pair<std::string, std::string>> maps = projection_maps(d);
+  std::vector<io::OutputFile> files{{dir / "diff.json", j.dump(2) + "\n"},
+                                    {dir / "report.html", diff_html(j, maps)}};
+  for (const auto& [name, svg] : maps) files.push_back({dir / name, svg});
   return files;
 }
 

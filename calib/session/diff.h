@@ -10,6 +10,8 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include "rigcal/io/files.h"
@@ -78,6 +80,11 @@ struct DiffConfig {
   double grid_step_px = 20;  // of the projection difference
 };
 
+// The two sensors of a relation's frames ("cam_r_lidar" of T_cam_r_lidar): the split at an
+// underscore where both parts are sensors of `rig`; none when there is no such split.
+std::optional<std::pair<std::string, std::string>> relation_sensors(std::string_view frames,
+                                                                    const rig::Rig& rig);
+
 // Poses are compared in A's base frame, or, when B has no sensor of that name, in the first
 // sensor of A that B has (said in `notes`). Throws rigcal::Error when they share no sensor.
 RigDifference diff_rigs(const rig::Rig& a, const rig::Rig& b, const DiffConfig& config = {});
@@ -93,8 +100,10 @@ std::string diff_html(const nlohmann::json& diff,
                       const std::vector<std::pair<std::string, std::string>>& figures);
 std::string diff_html_sections(const nlohmann::json& diff,
                                const std::vector<std::pair<std::string, std::string>>& figures);
-// The report: diff.json, report.html and, a camera, projection_diff_<camera>.svg (the fitted
-// difference over the image, with its colour bar).
+// Each camera's map: projection_diff_<camera>.svg (the fitted difference over the image, with
+// its colour bar), by file name.
+std::vector<std::pair<std::string, std::string>> projection_maps(const RigDifference& d);
+// The report: diff.json, report.html and the maps.
 std::vector<io::OutputFile> diff_report_files(const RigDifference& d,
                                               const std::filesystem::path& dir);
 

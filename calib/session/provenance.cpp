@@ -122,4 +122,11 @@ std::vector<StepRecord> read_steps(const rig::Rig& rig) {
   return out;
 }
 
+std::map<std::string, double> stored_sigmas(const rig::Rig& rig) {
+  std::map<std::string, double> out;
+  for (const StepRecord& s : read_steps(rig))
+    for (const report::Figure& f : s.sigmas) out[f.name] = f.value;
+  return out;
+}
+
 }  // namespace rigcal::session

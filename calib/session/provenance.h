@@ -3,6 +3,7 @@
 // input file or folder with its SHA-256 (a folder's over its files' names and contents), and the
 // `rigcal.steps` section of the calibration YAML.
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,10 @@ std::string steps_yaml(const std::vector<StepRecord>& records);
 // key they were written under as their name, with no unit. Throws rigcal::Error when the section
 // is not of this shape.
 std::vector<StepRecord> read_steps(const rig::Rig& rig);
+
+// Every 1-sigma the steps of a calibration stored, by the key it was written under
+// ("T_cam_r_lidar.t.x_m", "cam_l.fx_px", "imu.time_offset_s").
+std::map<std::string, double> stored_sigmas(const rig::Rig& rig);
 
 // "name_unit" unless the name ends with the unit already: the key a figure is written under.
 std::string figure_key(const report::Figure& figure);
