@@ -58,15 +58,19 @@ void run(Options o) {
     fmt::print("== {}: {}{}\n", s.step, s.status, s.cached ? " (cached: inputs unchanged)" : "");
     for (const std::string& line : s.summary) fmt::print("{}\n", line);
     for (const std::string& n : s.notes) fmt::print("note: {}\n", n);
+    for (const std::string& w : s.warnings) fmt::print("warning: {}\n", w);
     if (s.status != "ok") fmt::print("{}: {}\n", s.status, printable(s.reason, 2000));
     if (!s.remedy.empty()) fmt::print("what would settle it: {}\n", s.remedy);
   }
   print_table(r);
   if (r.published) {
-    fmt::print("\npublished {} (rigcal rig show prints its provenance); reports in {}/reports/\n",
-               r.calibration.string(), o.out);
+    fmt::print(
+        "\npublished {} (rigcal rig show prints its provenance); the report to read: "
+        "{}/report.html\n",
+        r.calibration.string(), o.out);
     return;
   }
+  fmt::print("\nthe report to read: {}/report.html\n", o.out);
   if (!r.removed_stale.empty())
     fmt::print("removed {}: an earlier run's, it does not match these inputs\n",
                r.removed_stale.string());
@@ -107,7 +111,8 @@ void add_calibrate(CLI::App& app) {
       "LiDAR with the clock offset (motion/: rigcal's own odometry on its ouster_points/, or\n"
       "--odometry FILE). Writes OUT/calib.yaml once,\n"
       "atomically, with rigcal.steps (inputs and their sha256, tool version, sigmas, residuals),\n"
-      "and OUT/reports/<step>/. A rerun reuses each step whose inputs, rig entries and options\n"
+      "OUT/report.html (the page to read: verdict, numbers with sigmas, warnings, figures) and\n"
+      "OUT/reports/<step>/. A rerun reuses each step whose inputs, rig entries and options\n"
       "are unchanged (OUT/cache/). Exit 0 every step that ran is ok (published when all ran);\n"
       "2 a step failed on bad input; 3 a step is undetermined by the data: the other steps'\n"
       "results are kept, nothing is published (an earlier OUT/calib.yaml is removed).");

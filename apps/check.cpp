@@ -42,6 +42,7 @@ void run(const Options& o) {
   for (const session::StepRun& s : r.estimate.steps) {
     fmt::print("== {} on {}: {}{}\n", s.step, o.session, s.status, s.cached ? " (cached)" : "");
     for (const std::string& n : s.notes) fmt::print("note: {}\n", n);
+    for (const std::string& w : s.warnings) fmt::print("warning: {}\n", w);
   }
   for (const std::string& line : session::check_lines(r)) fmt::print("{}\n", line);
   if (keep) {

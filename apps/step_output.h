@@ -36,8 +36,8 @@ inline report::Progress console_progress() {
 // Refuses any output that is one of the step's inputs (the rig it updates may be written in
 // place: that is not among them). Prints the summary and notes;
 // writes the report into `report_dir` (when given) and, when the
-// step is ok, the rig into `out` (when given). Undetermined: the report is written, the reason
-// and the remedy go to stderr, and the command exits 3 with `out` not written.
+// step is ok, the rig into `out` (when given), then the warnings. Undetermined: the report is
+// written, the reason and the remedy go to stderr, and the command exits 3 with `out` not written.
 inline void finish_step(const report::StepResult& r, const std::string& out,
                         const std::string& report_dir) {
   std::vector<io::OutputFile> files;
@@ -59,6 +59,7 @@ inline void finish_step(const report::StepResult& r, const std::string& out,
   io::write_files_atomic(files);
   for (const std::string& line : r.summary) fmt::print("{}\n", line);
   for (const std::string& n : r.notes) fmt::print("note: {}\n", n);
+  for (const std::string& w : r.warnings) fmt::print("warning: {}\n", w);
 }
 
 }  // namespace rigcal::cli

@@ -77,7 +77,7 @@ echo "== published with two recorded sequences (VBR layout: <place>/<seq>/vbr_ca
 mkdir -p "$out/vbr/campus/campus_train0" "$out/vbr/campus/campus_train1"
 "$rigcal" publish "$out/session/calib.yaml" "$out/vbr/campus/campus_train0" \
   "$out/vbr/campus/campus_train1" --formats vbr,rigcal,kalibr
-echo "The session's calibration: $out/session/calib.yaml (reports in $out/session/reports/)"
+echo "The session's calibration: $out/session/calib.yaml; the page to read: $out/session/report.html"
 
 echo
 echo "== the walk's ground truth (doc/ground-truth.md), written in its published sequence folder"
@@ -96,6 +96,7 @@ rc=0
   --markers "$out/sim/trajectories/markers.csv" --map "$out/ground_truth/campus_train0_map.ply" \
   --report "$out/ground_truth" || rc=$?
 if [ "$rc" -ne 0 ] && [ "$rc" -ne 3 ]; then exit "$rc"; fi
+echo "   the page to read: $out/ground_truth/report.html"
 echo "   scored against the truth:"
 "$rigcal" bench --gt "$out/sim/trajectories/truth_lidar.tum" --est "$seq/campus_train0_gt.txt" |
   sed -n '1,7p'

@@ -6,7 +6,9 @@
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
+#include <stdexcept>
 
+#include "rigcal/camera/lens.h"
 #include "rigcal/core/error.h"
 #include "rigcal/core/stats.h"
 
@@ -130,6 +132,7 @@ struct Parameters {
   std::vector<std::vector<double>> intr;   // per camera: its intrinsics block
   std::vector<Pose> cam_pose;              // per camera: T_c_0 (camera 0: identity, not solved)
   std::vector<std::optional<Pose>> board;  // per frame: T_0_board (none: no camera saw it)
+  bool hold_cameras = false;               // intrinsics and camera poses held: boards alone
 };
 
 // Throws rigcal::Error without cameras or when they differ in frame count.
@@ -309,7 +312,15 @@ void solve(const std::vector<CornerResidual>& residuals, const std::vector<Eigen
   for (size_t c = 1; c < cam_pose.size(); ++c) {
     if (problem.HasParameterBlock(cam_pose[c].q.coeffs().data())) {
       problem.SetManifold(cam_pose[c].q.coeffs().data(), new ceres::EigenQuaternionManifold);
+      if (x.hold_cameras) {
+        problem.SetParameterBlockConstant(cam_pose[c].q.coeffs().data());
+        problem.SetParameterBlockConstant(cam_pose[c].t.data());
+      }
     }
+  }
+  for (std::vector<double>& k : intr) {
+    if (x.hold_cameras && problem.HasParameterBlock(k.data()))
+      problem.SetParameterBlockConstant(k.data());
   }
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::SPARSE_SCHUR;
@@ -518,6 +529,74 @@ CalibrationResult calibrate(const Target& target, const std::vector<CameraInput>
   for (const auto& b : x.board)
     res.T_cam0_board.push_back(b ? std::optional<SE3>(b->se3()) : std::nullopt);
   return res;
+}
+
+FitAtStored fit_at_stored(const Target& target, const std::vector<CameraInput>& cams,
+                          const std::vector<rig::CameraModel>& models,
+                          const std::vector<SE3>& T_cam_cam0, const CalibrationOptions& opt) {
+  check_frames_pair_up(cams);
+  if (models.size() != cams.size() || T_cam_cam0.size() != cams.size())
+    throw std::invalid_argument("fit_at_stored: one model and one pose a camera");
+  const Lens lens{models[0].distortion_model == rig::DistortionModel::radtan,
+                  static_cast<int>(models[0].distortion_coeffs.size())};
+  for (const rig::CameraModel& m : models) {
+    if ((m.distortion_model == rig::DistortionModel::radtan) != lens.radtan ||
+        static_cast<int>(m.distortion_coeffs.size()) != lens.n_coeffs ||
+        (lens.n_coeffs != 4 && lens.n_coeffs != 5))
+      throw Error("the stored cameras' lens models differ: they cannot be fitted together");
+  }
+  const std::vector<Eigen::Vector3d> object = object_points(target);
+  // Each detected board's pose in each camera from its undistorted corners (PnP), as the start.
+  std::vector<std::vector<std::optional<SE3>>> T_c_board(cams.size());
+  for (size_t c = 0; c < cams.size(); ++c) {
+    T_c_board[c].assign(cams[c].frames.size(), std::nullopt);
+    for (size_t f = 0; f < cams[c].frames.size(); ++f) {
+      const Detection& d = cams[c].frames[f];
+      if (!d.found || d.pixels.size() < 6) continue;
+      std::vector<cv::Point3d> obj;
+      std::vector<cv::Point2d> img;
+      for (size_t i = 0; i < d.pixels.size(); ++i) {
+        const Eigen::Vector3d& p = object[d.point_ids[i]];
+        const Eigen::Vector2d xn = unproject(models[c], d.pixels[i]);
+        obj.emplace_back(p.x(), p.y(), p.z());
+        img.emplace_back(xn.x(), xn.y());
+      }
+      cv::Mat rvec, tvec;
+      if (cv::solvePnP(obj, img, cv::Mat::eye(3, 3, CV_64F), cv::Mat(), rvec, tvec))
+        T_c_board[c][f] = from_rvec_tvec(rvec, tvec);
+    }
+  }
+  Parameters x;
+  for (const rig::CameraModel& m : models) x.intr.push_back(intrinsics_vector(m));
+  x.cam_pose.resize(cams.size());
+  for (size_t c = 1; c < cams.size(); ++c) x.cam_pose[c] = Pose::from(T_cam_cam0[c]);
+  x.board = board_poses(T_c_board, x.cam_pose);
+  x.hold_cameras = true;
+  CalibrationResult res;
+  res.residuals = corner_residuals(cams, x.board);
+  if (res.residuals.empty()) throw Error("no detected board to fit the stored cameras to");
+  reject_outliers(res.residuals, object, lens, opt, x);
+  ceres::Problem problem;
+  solve(res.residuals, object, lens, false, opt.huber_px, x, problem);
+  update_residuals(res.residuals, object, lens, x);
+  FitAtStored out;
+  double sse = 0;
+  std::vector<double> camera_sse(cams.size(), 0.0);
+  std::vector<size_t> camera_n(cams.size(), 0);
+  for (const CornerResidual& cr : res.residuals) {
+    if (cr.outlier) {
+      ++out.outliers;
+      continue;
+    }
+    sse += cr.residual.squaredNorm();
+    camera_sse[cr.camera] += cr.residual.squaredNorm();
+    ++camera_n[cr.camera], ++out.corners;
+  }
+  for (const auto& b : x.board) out.views += b.has_value();
+  out.rms_2d_px = std::sqrt(sse / std::max<size_t>(1, out.corners));
+  for (size_t c = 0; c < cams.size(); ++c)
+    out.camera_rms_2d_px.push_back(std::sqrt(camera_sse[c] / std::max<size_t>(1, camera_n[c])));
+  return out;
 }
 
 }  // namespace rigcal::camera

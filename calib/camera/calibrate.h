@@ -44,6 +44,20 @@ struct CameraResult {
   size_t n_views = 0, n_corners = 0;
 };
 
+// The detections against given lenses and camera poses (a stored calibration), only the board
+// poses free: how well new images fit the stored parameters. Outliers are rejected as calibrate()
+// does (options.outlier_k_sigma), the RMS is over the inliers.
+struct FitAtStored {
+  double rms_2d_px = 0;                  // OpenCV's definition, as CalibrationResult's
+  std::vector<double> camera_rms_2d_px;  // per camera
+  size_t corners = 0, outliers = 0, views = 0;
+};
+// `models` and `T_cam_cam0` (camera 0: identity) one a camera, in the order of `cams`; the models
+// share one lens type. Throws rigcal::Error when they do not or no board was detected.
+FitAtStored fit_at_stored(const Target& target, const std::vector<CameraInput>& cams,
+                          const std::vector<rig::CameraModel>& models,
+                          const std::vector<SE3>& T_cam_cam0, const CalibrationOptions& options);
+
 struct CalibrationResult {
   std::vector<CameraResult> cameras;
   // T_cami_cam0 for every camera (identity for camera 0), and its 1-sigma in deg and m.

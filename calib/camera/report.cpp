@@ -9,6 +9,7 @@
 #include "rigcal/core/error.h"
 #include "rigcal/core/text.h"
 #include "rigcal/core/version.h"
+#include "rigcal/report/rotation.h"
 
 namespace rigcal::camera {
 namespace {
@@ -151,6 +152,7 @@ nlohmann::json cameras_json(const CalibrationResult& r, const CameraReportInput&
       const Eigen::Vector3d rpy = roll_pitch_yaw(T_c0.R) * 180.0 / M_PI;
       cj["T_cam_cam0"] = {{"from", in.camera_names[0]},
                           {"translation_m", {T_c0.t.x(), T_c0.t.y(), T_c0.t.z()}},
+                          {"axis_angle", report::axis_angle_json(T_c0.R)},
                           {"rotation_rpy_deg", {rpy.x(), rpy.y(), rpy.z()}},
                           {"baseline_m", T_c0.t.norm()},
                           {"translation_stddev_m",
@@ -236,6 +238,62 @@ cv::Mat coverage_png(const CalibrationResult& r, int camera, int width, int heig
               cv::Point(10, 25), cv::FONT_HERSHEY_SIMPLEX, 0.7, cv::Scalar(255, 255, 255), 1,
               cv::LINE_AA);
   return scaled;
+}
+
+std::string residuals_csv(const CalibrationResult& r, const std::vector<std::string>& names) {
+  std::string out = "camera,view,point,u_px,v_px,residual_u_px,residual_v_px,outlier\n";
+  for (const CornerResidual& cr : r.residuals) {
+    out += fmt::format("{},{},{},{:.3f},{:.3f},{:.5f},{:.5f},{}\n", names.at(cr.camera), cr.frame,
+                       cr.point, cr.observed.x(), cr.observed.y(), cr.residual.x(), cr.residual.y(),
+                       cr.outlier ? 1 : 0);
+  }
+  return out;
+}
+
+std::vector<std::string> coverage_warnings(const CalibrationResult& r, int camera,
+                                           const std::string& name, int width, int height) {
+  static const char* kCells[3][3] = {{"top-left", "top", "top-right"},
+                                     {"left", "centre", "right"},
+                                     {"bottom-left", "bottom", "bottom-right"}};
+  int cells[3][3] = {};
+  int total = 0;
+  for (const CornerResidual& cr : r.residuals) {
+    if (cr.camera != camera || cr.outlier) continue;
+    const int u = std::clamp(static_cast<int>(3 * cr.observed.x() / width), 0, 2);
+    const int v = std::clamp(static_cast<int>(3 * cr.observed.y() / height), 0, 2);
+    ++cells[v][u], ++total;
+  }
+  if (total == 0) return {};
+  std::vector<std::string> empty;
+  for (int v = 0; v < 3; ++v)
+    for (int u = 0; u < 3; ++u)
+      if (cells[v][u] == 0) empty.push_back(kCells[v][u]);
+  // Each half's share of the corners, by the corners' own positions.
+  const struct {
+    const char* name;
+    bool (*in)(const Eigen::Vector2d&, int, int);
+  } halves[] = {{"left", [](const Eigen::Vector2d& p, int w, int) { return p.x() < w / 2.0; }},
+                {"right", [](const Eigen::Vector2d& p, int w, int) { return p.x() >= w / 2.0; }},
+                {"top", [](const Eigen::Vector2d& p, int, int h) { return p.y() < h / 2.0; }},
+                {"bottom", [](const Eigen::Vector2d& p, int, int h) { return p.y() >= h / 2.0; }}};
+  std::vector<std::string> out;
+  for (const auto& half : halves) {
+    int n = 0;
+    for (const CornerResidual& cr : r.residuals)
+      n += cr.camera == camera && !cr.outlier && half.in(cr.observed, width, height);
+    if (n * 10 >= total) continue;
+    out.push_back(fmt::format(
+        "{}: the {} half of the image holds {} of its {} corners ({:.0f} %): the lens there is "
+        "extrapolated from the rest, not measured; record the board in that part of the image",
+        name, half.name, n, total, 100.0 * n / total));
+  }
+  if (out.empty() && !empty.empty()) {
+    out.push_back(fmt::format(
+        "{}: no corners in the {} {} of the image (3 x 3 cells): the lens there is extrapolated, "
+        "not measured; record the board there",
+        name, fmt::join(empty, ", "), empty.size() == 1 ? "ninth" : "ninths"));
+  }
+  return out;
 }
 
 cv::Mat uncertainty_png(const UncertaintyMap& m, int width, int height) {

@@ -37,6 +37,17 @@ cv::Mat corners_png(const cv::Mat& gray, const Detection& detection);
 cv::Mat residuals_png(const CalibrationResult& result, int camera, int width, int height,
                       double magnify);
 cv::Mat coverage_png(const CalibrationResult& result, int camera, int width, int height);
+
+// Every corner's residual, one line each (`camera,view,point,u_px,v_px,residual_u_px,
+// residual_v_px,outlier`, the residual projected - observed), for the HTML report's figures.
+std::string residuals_csv(const CalibrationResult& result,
+                          const std::vector<std::string>& camera_names);
+
+// Where a camera's image holds too few inlier corners for its lens to be measured there: a half
+// of the image with under a tenth of them, or a ninth of it (3 x 3 cells) with none. Empty when
+// the board covered the image.
+std::vector<std::string> coverage_warnings(const CalibrationResult& result, int camera,
+                                           const std::string& name, int width, int height);
 cv::Mat uncertainty_png(const UncertaintyMap& map, int width, int height);
 
 }  // namespace rigcal::camera

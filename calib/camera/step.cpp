@@ -17,6 +17,7 @@
 #include "rigcal/io/files.h"
 #include "rigcal/io/target_yaml.h"
 #include "rigcal/report/json.h"
+#include "rigcal/report/rotation.h"
 #include "rigcal/rig/rig_yaml.h"
 
 namespace rigcal::camera {
@@ -149,12 +150,11 @@ std::vector<std::string> summary_lines(const std::vector<std::string>& names,
   }
   for (size_t c = 1; c < names.size(); ++c) {
     out.push_back(fmt::format(
-        "T_{}_{}: baseline {:.5f} m, t = [{:.5f} {:.5f} {:.5f}] ± [{:.5f} {:.5f} {:.5f}] m, "
-        "rotation ± [{:.4f} {:.4f} {:.4f}] deg",
+        "T_{}_{}: baseline {:.5f} m, t = [{:.5f} {:.5f} {:.5f}] ± [{:.5f} {:.5f} {:.5f}] m, {}",
         names[c], names[0], r.T_cam_cam0[c].t.norm(), r.T_cam_cam0[c].t.x(), r.T_cam_cam0[c].t.y(),
         r.T_cam_cam0[c].t.z(), r.translation_stddev_m[c].x(), r.translation_stddev_m[c].y(),
-        r.translation_stddev_m[c].z(), r.rotation_stddev_deg[c].x(), r.rotation_stddev_deg[c].y(),
-        r.rotation_stddev_deg[c].z()));
+        r.translation_stddev_m[c].z(),
+        report::rotation_text(r.T_cam_cam0[c].R, r.rotation_stddev_deg[c], names[c])));
   }
   return out;
 }
@@ -209,12 +209,54 @@ report::StepResult calibrate_cameras(const StepInputs& in, const StepOptions& o,
         rep.uncertainty_distance_m));
   }
   out.report = cameras_json(r, rep);
+  std::optional<FitAtStored> at_rig;
+  if (o.fit_at_rig) {
+    // The given rig's lenses and stereo poses, when it has every camera with this lens model.
+    std::vector<rig::CameraModel> models;
+    std::vector<SE3> poses;
+    std::string missing;
+    for (size_t c = 0; c < n_cams && in.rig; ++c) {
+      const rig::Sensor* s = rig::find_sensor(*in.rig, names[c]);
+      if (!s || s->type != rig::SensorType::camera || s->camera.fx <= 0 ||
+          s->camera.distortion_model != copt.model ||
+          s->camera.distortion_coeffs.size() != r.cameras[c].model.distortion_coeffs.size()) {
+        missing = names[c];
+        break;
+      }
+      models.push_back(s->camera);
+      poses.push_back(rig::T_a_b(*in.rig, names[c], names[0]));
+    }
+    if (!in.rig || !missing.empty()) {
+      out.notes.push_back(fmt::format(
+          "the rig has no {} with this lens model ({}): the images are not fitted to it",
+          missing.empty() ? "camera" : missing, o.model));
+    } else {
+      at_rig = fit_at_stored(target, d.cameras, models, poses, copt);
+      nlohmann::json per_camera;
+      for (size_t c = 0; c < n_cams; ++c) per_camera[names[c]] = at_rig->camera_rms_2d_px[c];
+      out.report["at_rig"] = {
+          {"definition",
+           "the detections fitted to the given rig's lenses and stereo poses, only the boards' "
+           "poses free (outliers rejected as in the calibration): RMS over the inlier corners"},
+          {"rms_2d_px", at_rig->rms_2d_px},
+          {"camera_rms_2d_px", per_camera},
+          {"corners", at_rig->corners},
+          {"outliers", at_rig->outliers},
+          {"views", at_rig->views}};
+    }
+  }
   for (const std::string& n : in.images.notes) out.report["notes"].push_back(n);
   std::vector<std::string> all_images;
   std::vector<Detection> all_detections;
   for (const auto& [c, f] : d.jobs)
     all_images.push_back(in.images.files[c][f]), all_detections.push_back(d.cameras[c].frames[f]);
+  for (size_t c = 0; c < n_cams; ++c) {
+    for (const std::string& w : coverage_warnings(r, static_cast<int>(c), names[c],
+                                                  d.cameras[c].width, d.cameras[c].height))
+      out.warnings.push_back(w);
+  }
   out.report_files.push_back({"corners.vnl", corners_vnl(target, all_images, all_detections)});
+  out.report_files.push_back({"residuals.csv", residuals_csv(r, names)});
   out.report_files.push_back({"cameras.json", report::json_text(out.report)});
   report::finish_report(out, "cameras.json");
   for (size_t c = 0; c < n_cams; ++c) {
@@ -244,6 +286,7 @@ report::StepResult calibrate_cameras(const StepInputs& in, const StepOptions& o,
                    {"rms_coord_px", r.rms_coord_px, "px"},
                    {"outlier_corners", static_cast<double>(r.n_outliers), ""},
                    {"corners", static_cast<double>(r.residuals.size()), ""}};
+  if (at_rig) out.residuals.push_back({"rms_2d_at_rig_px", at_rig->rms_2d_px, "px"});
   static const char* kIntrinsics[] = {"fx", "fy", "cx", "cy"};
   for (size_t c = 0; c < n_cams; ++c) {
     for (int i = 0; i < 4; ++i) {

@@ -13,6 +13,7 @@
 #include "rigcal/core/error.h"
 #include "rigcal/core/text.h"
 #include "rigcal/core/version.h"
+#include "rigcal/gt/report_html.h"
 #include "rigcal/io/ground_truth_io.h"
 #include "rigcal/io/odometry_io.h"
 #include "rigcal/io/trajectory_io.h"
@@ -638,9 +639,15 @@ std::vector<io::OutputFile> ground_truth_files(const GroundTruthRun& run,
                                                const GroundTruthPaths& paths) {
   const PoseGraphResult& g = run.graph;
   std::vector<io::OutputFile> files;
-  if (!paths.report.empty())
+  if (!paths.report.empty()) {
     files.push_back({paths.report,
                      report.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"});
+    // The page a person reads, and the top view it shows, beside the JSON.
+    const std::filesystem::path dir = paths.report.parent_path();
+    const std::string top = g.T_enu_lidar.empty() ? "" : trajectory_top_svg(g);
+    if (!top.empty()) files.push_back({dir / "trajectory_top.svg", top});
+    files.push_back({dir / "report.html", ground_truth_html(report, top)});
+  }
   if (run.chunk_motions) {
     const Trajectory& T = run.chunk_motions->T_odom_lidar;
     if (!T.empty() && !paths.trajectory.empty()) {

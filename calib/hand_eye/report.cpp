@@ -6,6 +6,7 @@
 
 #include "rigcal/core/version.h"
 #include "rigcal/report/json.h"
+#include "rigcal/report/rotation.h"
 #include "rigcal/report/svg_plot.h"
 
 namespace rigcal::hand_eye {
@@ -33,6 +34,7 @@ std::vector<io::OutputFile> hand_eye_report_files(const std::filesystem::path& d
                  {"stride_s", in.stride_s},
                  {"min_rotation_deg", in.min_rotation_deg}};
   j["T_gnss_lidar"] = {{"t_m", report::vector_json(X.t)},
+                       {"axis_angle", report::axis_angle_json(X.R)},
                        {"roll_pitch_yaw_deg", report::vector_json(rpy)},
                        {"t_sigma_m", report::vector_json(sig_t)},
                        {"rotation_sigma_deg", report::vector_json(sig_r)},

@@ -17,6 +17,7 @@
 #include "rigcal/io/session.h"
 #include "rigcal/lidar/step.h"
 #include "rigcal/report/json.h"
+#include "rigcal/report/rotation.h"
 #include "rigcal/rig/rig_yaml.h"
 
 namespace rigcal::hand_eye {
@@ -283,7 +284,6 @@ report::StepResult estimate(const StepInputs& in, const StepOptions& o, const Tr
         "({:+.3f} ms from the angular velocities' estimate)",
         offset_s, r.time_offset_sigma_s, 1e3 * r.time_offset_correction_s));
   }
-  const Eigen::Vector3d rpy = roll_pitch_yaw(X.R) * 180.0 / M_PI;
   const Eigen::Vector3d &sig_r = r.rotation_sigma_deg, &sig_t = r.translation_sigma_m;
   size_t outliers = 0;
   for (bool b : r.outlier) outliers += b;
@@ -306,10 +306,10 @@ report::StepResult estimate(const StepInputs& in, const StepOptions& o, const Tr
       ob.rotation_singular_values[2], ob.translation_sigma_m[0], ob.translation_sigma_m[1],
       ob.translation_sigma_m[2]));
   out.summary.push_back(
-      fmt::format("T_{}_{}: t = [{:.4f} {:.4f} {:.4f}] ± [{:.4f} {:.4f} {:.4f}] m, roll pitch yaw "
-                  "{:.3f} {:.3f} {:.3f} ± {:.3f} {:.3f} {:.3f} deg; {} outlier pairs",
+      fmt::format("T_{}_{}: t = [{:.4f} {:.4f} {:.4f}] ± [{:.4f} {:.4f} {:.4f}] m, {}; {} outlier "
+                  "pairs",
                   o.sensor, o.lidar_sensor, X.t.x(), X.t.y(), X.t.z(), sig_t.x(), sig_t.y(),
-                  sig_t.z(), rpy.x(), rpy.y(), rpy.z(), sig_r.x(), sig_r.y(), sig_r.z(), outliers));
+                  sig_t.z(), report::rotation_text(X.R, sig_r, o.sensor), outliers));
   out.summary.push_back(
       fmt::format("odometry scale {:.5f} ± {:.5f} (GNSS/INS distance over LiDAR distance)",
                   r.odometry_scale, r.odometry_scale_sigma));

@@ -10,6 +10,7 @@
 #include "rigcal/core/version.h"
 #include "rigcal/report/json.h"
 #include "rigcal/report/png.h"
+#include "rigcal/report/rotation.h"
 
 namespace rigcal::lidar_camera {
 cv::Mat overlay(const cv::Mat& image, const std::vector<Eigen::Vector3d>& scan,
@@ -67,6 +68,7 @@ std::vector<io::OutputFile> lidar_camera_report_files(const std::filesystem::pat
   const SE3& T = s.T_camera_lidar;
   j["T_camera_lidar"] = {
       {"t_m", report::vector_json(T.t)},
+      {"axis_angle", report::axis_angle_json(T.R)},
       {"roll_pitch_yaw_deg", report::vector_json(roll_pitch_yaw(T.R) * 180.0 / M_PI)},
       {"t_sigma_m", report::vector_json(s.translation_sigma_m)},
       {"rotation_sigma_deg", report::vector_json(s.rotation_sigma_deg)},

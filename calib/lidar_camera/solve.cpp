@@ -239,4 +239,17 @@ Calibration calibrate(const std::vector<PairInput>& in, const BoardSearch& searc
   return out;
 }
 
+std::vector<std::string> outlier_warnings(const Solution& s) {
+  size_t outliers = 0;
+  for (const PairResidual& r : s.residuals) outliers += r.outlier;
+  const size_t solved = s.residuals.size();
+  if (solved == 0 || 3 * outliers <= solved) return {};
+  return {fmt::format(
+      "{} of the {} pairs used are outliers (their board planes disagree with the solution by "
+      "more than chi-square 16.3 over 3): the extrinsic rests on the other {}. Look at each "
+      "pair's overlay: a wrong plane taken as the board, a board that moved between the image "
+      "and the scan, or clocks apart",
+      outliers, solved, solved - outliers)};
+}
+
 }  // namespace rigcal::lidar_camera

@@ -57,6 +57,10 @@ struct Solution {
 // Throws rigcal::Error when the boards do not determine the extrinsic (observability().reason).
 Solution solve(const std::vector<BoardPair>& pairs, double huber = 3.0);
 
+// A warning when more than a third of the solved pairs are outliers (the solution then rests on
+// the rest, which a person should look at); empty otherwise.
+std::vector<std::string> outlier_warnings(const Solution& solution);
+
 // The residuals of the boards under a given extrinsic (another tool's, an old calibration's):
 // how well it makes the two sensors' planes agree.
 std::vector<PairResidual> residuals_at(const std::vector<BoardPair>& pairs,

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+
 #include "rigcal/camera/detect.h"
 #include "rigcal/core/error.h"
 #include "rigcal/io/image_io.h"
@@ -9,6 +11,8 @@
 #include "rigcal/io/point_cloud_io.h"
 #include "rigcal/io/target_yaml.h"
 #include "rigcal/lidar_camera/report.h"
+#include "rigcal/report/json.h"
+#include "rigcal/report/rotation.h"
 
 namespace rigcal::lidar_camera {
 namespace fs = std::filesystem;
@@ -124,19 +128,36 @@ report::StepResult calibrate_lidar_camera(const StepInputs& in, const StepOption
   for (size_t k = 0; k < c.pairs.size(); ++k)
     out.summary.push_back(fmt::format("pair {:2d}: {}", k + 1, c.pairs[k].note));
   const SE3& T = s.T_camera_lidar;
-  const Eigen::Vector3d rpy = roll_pitch_yaw(T.R) * 180.0 / M_PI;
   out.summary.push_back(fmt::format(
-      "T_{}_{}: t = [{:.4f} {:.4f} {:.4f}] ± [{:.4f} {:.4f} {:.4f}] m, roll pitch yaw {:.3f} "
-      "{:.3f} {:.3f} ± {:.3f} {:.3f} {:.3f} deg",
-      o.camera, o.lidar, T.t.x(), T.t.y(), T.t.z(), s.translation_sigma_m.x(),
-      s.translation_sigma_m.y(), s.translation_sigma_m.z(), rpy.x(), rpy.y(), rpy.z(),
-      s.rotation_sigma_deg.x(), s.rotation_sigma_deg.y(), s.rotation_sigma_deg.z()));
+      "T_{}_{}: t = [{:.4f} {:.4f} {:.4f}] ± [{:.4f} {:.4f} {:.4f}] m, {}", o.camera, o.lidar,
+      T.t.x(), T.t.y(), T.t.z(), s.translation_sigma_m.x(), s.translation_sigma_m.y(),
+      s.translation_sigma_m.z(), report::rotation_text(T.R, s.rotation_sigma_deg, o.camera)));
   out.summary.push_back(fmt::format(
       "observability: normals' singular values {:.3f} {:.3f} {:.3f}, condition {:.1f}; noise "
       "scale {:.2f}",
       s.observability.singular_values[0], s.observability.singular_values[1],
       s.observability.singular_values[2], s.observability.condition, s.noise_scale));
   out.notes = in.notes;
+  out.warnings = outlier_warnings(s);
+  std::optional<Solution> at_rig;  // the boards at the given rig's extrinsic, when asked
+  const std::optional<SE3> fit_at = o.fit_at ? o.fit_at : prior;
+  if (o.fit_at_rig && fit_at) {
+    std::vector<BoardPair> used;
+    for (size_t k = 0; k < pairs.size(); ++k) {
+      if (c.pairs[k].used)
+        used.push_back({pairs[k].camera->plane, c.pairs[k].lidar.plane, c.pairs[k].lidar.points});
+    }
+    Solution a;
+    a.T_camera_lidar = *fit_at;
+    a.residuals = residuals_at(used, *fit_at);
+    double ss = 0;
+    for (const PairResidual& r : a.residuals) ss += r.chi2;
+    a.noise_scale = std::sqrt(ss / std::max<double>(1, 3.0 * a.residuals.size()));
+    at_rig = a;
+  } else if (o.fit_at_rig) {
+    out.notes.push_back(fmt::format("the rig places no {} against {}: nothing to fit the boards to",
+                                    o.camera, o.lidar));
+  }
 
   LidarCameraInputs rin{in.images,
                         in.scans,
@@ -146,6 +167,29 @@ report::StepResult calibrate_lidar_camera(const StepInputs& in, const StepOption
                         search.board_width_m,
                         search.board_height_m};
   out.report_files = lidar_camera_report_files("", rin, pairs, c, cam, shown);
+  double angle_rms_deg = 0, distance_rms_m = 0;
+  if (at_rig) {
+    for (const PairResidual& r : at_rig->residuals) {
+      angle_rms_deg += r.normal_angle_deg * r.normal_angle_deg / at_rig->residuals.size();
+      distance_rms_m += r.distance_m * r.distance_m / at_rig->residuals.size();
+    }
+    angle_rms_deg = std::sqrt(angle_rms_deg), distance_rms_m = std::sqrt(distance_rms_m);
+    for (io::OutputFile& f : out.report_files) {
+      if (f.path != "lidar_camera.json") continue;
+      nlohmann::json j = nlohmann::json::parse(f.content);
+      nlohmann::json chi2 = nlohmann::json::array();
+      for (const PairResidual& r : at_rig->residuals) chi2.push_back(r.chi2);
+      j["at_rig"] = {
+          {"definition",
+           "the boards of the pairs used, at the given rig's extrinsic (not re-estimated): "
+           "noise_scale = sqrt(sum chi2 / (3 pairs)), 1 when they fit as their covariances say"},
+          {"noise_scale", at_rig->noise_scale},
+          {"normal_angle_rms_deg", angle_rms_deg},
+          {"distance_rms_m", distance_rms_m},
+          {"pair_chi2", chi2}};
+      f.content = report::json_text(j);
+    }
+  }
   report::finish_report(out, "lidar_camera.json");
 
   // The camera placed from the LiDAR: T_b(camera) = T_b(lidar) T_camera_lidar^-1; every other
@@ -168,6 +212,11 @@ report::StepResult calibrate_lidar_camera(const StepInputs& in, const StepOption
                    {"pairs", static_cast<double>(c.pairs.size()), ""},
                    {"noise_scale", s.noise_scale, ""},
                    {"condition", s.observability.condition, ""}};
+  if (at_rig) {
+    out.residuals.push_back({"noise_scale_at_rig", at_rig->noise_scale, ""});
+    out.residuals.push_back({"normal_angle_rms_at_rig_deg", angle_rms_deg, "deg"});
+    out.residuals.push_back({"distance_rms_at_rig_m", distance_rms_m, "m"});
+  }
   const std::string name = fmt::format("T_{}_{}", o.camera, o.lidar);
   for (int a = 0; a < 3; ++a)
     out.sigmas.push_back({fmt::format("{}.t.{}", name, "xyz"[a]), s.translation_sigma_m[a], "m"});

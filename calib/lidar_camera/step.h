@@ -20,6 +20,12 @@ struct StepOptions {
   double corner_sigma_px = 0.1;
   double max_dt_s = 0.05;             // a recording's image takes the nearest scan within this
   io::Bayer bayer = io::Bayer::none;  // raw mosaics: demosaiced to gray
+  // Also the boards' residuals at the given rig's extrinsic (rigcal check: the new data at the
+  // stored calibration): the report's `at_rig` and the residual figures named `..._at_rig_<unit>`.
+  bool fit_at_rig = false;
+  // The extrinsic T_camera_lidar to fit them at instead of the given rig's (the session pipeline
+  // passes the stored calibration's: its rig has the re-estimated cameras by then).
+  std::optional<SE3> fit_at;
 };
 
 struct StepInputs {

@@ -17,6 +17,7 @@ void finish_report(StepResult& r, std::string_view json_file) {
     if (f.path != json_file) continue;
     r.report = nlohmann::json::parse(f.content);
     r.report["status"] = to_string(r.status);
+    r.report["warnings"] = r.warnings;
     if (r.status != StepStatus::ok) {
       r.report["reason"] = r.reason;
       r.report["remedy"] = r.remedy;

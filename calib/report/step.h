@@ -49,12 +49,16 @@ struct StepResult {
   std::vector<io::OutputFile> report_files;
   // Lines for people, in the order a terminal shows them; notes are what was assumed or noticed.
   std::vector<std::string> summary, notes;
+  // What a person must look at before trusting an ok result (many outlier pairs, an image half
+  // without corners): printed as "warning:", first in the report.
+  std::vector<std::string> warnings;
   std::vector<Figure> sigmas, residuals;
   std::vector<Input> inputs;
 };
 
-// Sets result.report from its JSON file among report_files (`json_file`), with the status (and
-// the reason and remedy when undetermined) added, and writes it back. Throws when it is absent.
+// Sets result.report from its JSON file among report_files (`json_file`), with the status, the
+// warnings (and the reason and remedy when undetermined) added, and writes it back. Throws when it
+// is absent.
 void finish_report(StepResult& result, std::string_view json_file);
 
 // The report's files under `dir`: <step>.json (the report with the status added) and the figures.

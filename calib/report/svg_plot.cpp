@@ -66,17 +66,22 @@ Bounds bounds(const Plot& plot, double pw, double ph) {
   for (const PlotSeries& s : plot.series) {
     for (size_t i = 0; i < s.x.size(); ++i) {
       if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
+      const double e = i < s.y_error.size() && std::isfinite(s.y_error[i]) ? s.y_error[i] : 0.0;
       x0 = std::min(x0, s.x[i]), x1 = std::max(x1, s.x[i]);
-      y0 = std::min(y0, s.y[i]), y1 = std::max(y1, s.y[i]);
+      y0 = std::min(y0, s.y[i] - e), y1 = std::max(y1, s.y[i] + e);
     }
     for (double v : s.values) {
       if (std::isfinite(v)) v0 = std::min(v0, v), v1 = std::max(v1, v);
     }
   }
   if (!std::isfinite(x0)) x0 = 0, x1 = 1, y0 = 0, y1 = 1;
+  if (plot.limits.size() == 4)
+    x0 = plot.limits[0], x1 = plot.limits[1], y0 = plot.limits[2], y1 = plot.limits[3];
   if (x1 - x0 < 1e-12) x0 -= 0.5, x1 += 0.5;
   if (y1 - y0 < 1e-12) y0 -= 0.5, y1 += 0.5;
-  if (!plot.equal_axes) {  // a margin, so that points on the extremes are not cut by the frame
+  if (!plot.equal_axes &&
+      plot.limits.size() !=
+          4) {  // a margin, so that points on the extremes are not cut by the frame
     const double m = 0.03 * (y1 - y0);
     y0 -= m, y1 += m;
   }
@@ -143,6 +148,20 @@ std::string render_svg(const Plot& plot) {
         const double f = v1 > v0 ? (s.values[i] - v0) / (v1 - v0) : 0.0;
         out += fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"2\" fill=\"{}\"/>\n", X(s.x[i]),
                            Y(s.y[i]), viridis(f));
+      }
+      continue;
+    }
+    if (s.points || !s.y_error.empty()) {
+      for (size_t i = 0; i < s.x.size(); i += stride) {
+        if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
+        if (i < s.y_error.size() && std::isfinite(s.y_error[i])) {
+          out += fmt::format(
+              "<line x1=\"{0:.1f}\" y1=\"{1:.1f}\" x2=\"{0:.1f}\" y2=\"{2:.1f}\" "
+              "stroke=\"{3}\"/>\n",
+              X(s.x[i]), Y(s.y[i] - s.y_error[i]), Y(s.y[i] + s.y_error[i]), kPalette[k % 10]);
+        }
+        out += fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"2.5\" fill=\"{}\"/>\n",
+                           X(s.x[i]), Y(s.y[i]), kPalette[k % 10]);
       }
       continue;
     }
@@ -235,7 +254,7 @@ std::string render_png(const Plot& plot) {
       if (std::isfinite(s.x[i]) && std::isfinite(s.y[i]))
         pts.push_back(P(X(s.x[i]) - kLeft, Y(s.y[i]) - kTop));
     }
-    if (!s.values.empty()) {
+    if (!s.values.empty() || s.points || !s.y_error.empty()) {
       for (size_t i = 0; i < pts.size(); ++i) cv::circle(area, pts[i], 2, colour(k), cv::FILLED);
     } else if (pts.size() > 1) {
       cv::polylines(area, pts, false, colour(k), 1, cv::LINE_AA);

@@ -11,14 +11,17 @@ struct PlotSeries {
   std::string label;
   std::vector<double> x, y;
   std::vector<double> values;  // non-empty: draw points coloured by these (viridis), with a bar
+  bool points = false;         // markers in the series' colour instead of a line
+  std::vector<double> y_error = {};  // non-empty: markers with bars of +- these (1-sigma) in y
 };
 
 struct Plot {
   std::string title, x_label, y_label, value_label;
   std::vector<PlotSeries> series;
-  bool equal_axes = false;  // same scale on x and y (top views)
-  bool step = false;        // draw lines as steps (cumulative curves)
-  bool y_down = false;      // y grows downwards (image rows)
+  bool equal_axes = false;          // same scale on x and y (top views)
+  bool step = false;                // draw lines as steps (cumulative curves)
+  bool y_down = false;              // y grows downwards (image rows)
+  std::vector<double> limits = {};  // empty, or x0 x1 y0 y1: the axes' range (an image's extent)
 };
 
 std::string render_svg(const Plot& plot);

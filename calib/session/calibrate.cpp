@@ -16,6 +16,7 @@
 #include "rigcal/report/json.h"
 #include "rigcal/rig/rig_yaml.h"
 #include "rigcal/session/provenance.h"
+#include "rigcal/session/report_html.h"
 
 namespace rigcal::session {
 namespace fs = std::filesystem;
@@ -97,21 +98,28 @@ struct Cached {
   std::vector<HashedInput> inputs;
 };
 
-nlohmann::json cache_json(const std::string& key, const StepRun& run, const rig::Rig& rig,
-                          const std::vector<std::string>& wrote,
-                          const std::vector<HashedInput>& inputs) {
+// What a step's run says, as the cache and OUT/reports/calibrate.json store it.
+nlohmann::json run_json(const StepRun& run) {
   nlohmann::json j;
-  j["key"] = key;
-  j["tool_version"] = version_string();
   j["step"] = run.step;
   j["status"] = run.status;
   j["reason"] = run.reason;
   j["remedy"] = run.remedy;
   j["summary"] = run.summary;
   j["notes"] = run.notes;
+  j["warnings"] = run.warnings;
   j["sigmas"] = figures_json(run.sigmas);
   j["residuals"] = figures_json(run.residuals);
   j["seconds"] = run.seconds;
+  return j;
+}
+
+nlohmann::json cache_json(const std::string& key, const StepRun& run, const rig::Rig& rig,
+                          const std::vector<std::string>& wrote,
+                          const std::vector<HashedInput>& inputs) {
+  nlohmann::json j = run_json(run);
+  j["key"] = key;
+  j["tool_version"] = version_string();
   j["wrote"] = wrote;
   j["rig"] = rig::rig_to_yaml(rig);
   j["inputs"] = nlohmann::json::array();
@@ -135,6 +143,7 @@ std::optional<Cached> read_cache(const fs::path& file, const std::string& key) {
     c.run.remedy = j.at("remedy");
     c.run.summary = j.at("summary").get<std::vector<std::string>>();
     c.run.notes = j.at("notes").get<std::vector<std::string>>();
+    c.run.warnings = j.at("warnings").get<std::vector<std::string>>();
     c.run.sigmas = figures_from(j.at("sigmas"));
     c.run.residuals = figures_from(j.at("residuals"));
     c.run.cached = true;
@@ -217,8 +226,9 @@ std::vector<Plan> make_plans(const CalibrateOptions& o, const io::Session& s,
       if (!rec.empty() && fs::is_directory(rec / f)) p.inputs.emplace_back(f, rec / f);
     }
     p.reads = {"cam_l", "cam_r"};
-    p.options = fmt::format("model {} outlier_sigma {} bayer {}", o.cameras.model,
-                            o.cameras.outlier_sigma, io::to_string(o.cameras.bayer));
+    p.options =
+        fmt::format("model {} outlier_sigma {} bayer {} fit_at_rig {}", o.cameras.model,
+                    o.cameras.outlier_sigma, io::to_string(o.cameras.bayer), o.cameras.fit_at_rig);
     p.reuse_detections = std::make_shared<bool>(false);
     p.run = [rec, target, out, opt = o.cameras, reuse = p.reuse_detections](
                 const rig::Rig& rig, const report::Progress& pr) {
@@ -252,6 +262,11 @@ std::vector<Plan> make_plans(const CalibrateOptions& o, const io::Session& s,
         lo.roi ? fmt::format("{} {}", fmt::join(lo.roi->first, ","), fmt::join(lo.roi->second, ","))
                : "none",
         lo.corner_sigma_px, lo.max_dt_s);
+    if (lo.fit_at_rig) {
+      p.options += " fit_at_rig";
+      const Eigen::Matrix4d T = lo.fit_at ? lo.fit_at->matrix() : Eigen::Matrix4d::Zero();
+      for (int i = 0; i < 12; ++i) p.options += fmt::format(" {:.17g}", T(i / 4, i % 4));
+    }
     p.run = [rec, target, lo](const rig::Rig& rig, const report::Progress& pr) {
       lidar_camera::StepInputs in = lidar_camera::pairs_from_recording(rec, rig, lo);
       in.target = target;
@@ -364,8 +379,15 @@ CalibrateResult calibrate(const CalibrateOptions& o, const Progress& progress) {
   const fs::path target = o.target.empty() ? s.target : o.target;
   CalibrateResult result;
   result.rig = rig::read_rig_file(rig_file);
+  // Fitting the LiDAR-camera boards at the given rig: at its extrinsic as given, before the
+  // cameras step moves the cameras.
+  CalibrateOptions planned = o;
+  lidar_camera::StepOptions& lo = planned.lidar_camera;
+  if (lo.fit_at_rig && !lo.fit_at && rig::find_sensor(result.rig, lo.camera) &&
+      rig::find_sensor(result.rig, lo.lidar))
+    lo.fit_at = rig::T_a_b(result.rig, lo.camera, lo.lidar);
   // A GNSS/INS sensor's attached sensors are read (and written) by hand-eye too.
-  std::vector<Plan> plans = make_plans(o, s, target, o.out);
+  std::vector<Plan> plans = make_plans(planned, s, target, o.out);
   for (Plan& p : plans) {
     if (p.step == "lidar_camera") {
       p.reads = camera_names(result.rig);
@@ -468,7 +490,7 @@ CalibrateResult calibrate(const CalibrateOptions& o, const Progress& progress) {
         run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         run.status = std::string(report::to_string(r.status));
         run.reason = r.reason, run.remedy = r.remedy;
-        run.summary = r.summary, run.notes = r.notes;
+        run.summary = r.summary, run.notes = r.notes, run.warnings = r.warnings;
         run.sigmas = r.sigmas, run.residuals = r.residuals;
         step_rig = r.rig;
         wrote = r.wrote;
@@ -518,6 +540,22 @@ CalibrateResult calibrate(const CalibrateOptions& o, const Progress& progress) {
     fs::remove(o.out / "calib.yaml");
     result.removed_stale = o.out / "calib.yaml";
   }
+  // The run as a person reads it: OUT/reports/calibrate.json, rendered into OUT/report.html.
+  nlohmann::json j;
+  j["tool_version"] = version_string();
+  j["session"] = io::source_path(s, s.root).string();
+  j["published"] = result.published;
+  j["calibration"] = result.calibration.string();
+  j["exit_status"] = result.exit_status;
+  j["steps"] = nlohmann::json::array();
+  for (const StepRun& run : result.steps) {
+    nlohmann::json r = run_json(run);
+    r["cached"] = run.cached;
+    j["steps"].push_back(r);
+  }
+  io::write_file_atomic(o.out / "reports" / "calibrate.json", report::json_text(j));
+  const io::OutputFile page = render_report(o.out);
+  io::write_file_atomic(page.path, page.content);
   return result;
 }
 

@@ -56,7 +56,7 @@ struct StepRun {
   bool cached = false;  // taken from OUT/cache without running
   double seconds = 0;   // running time (0 when cached or not run)
   std::string reason, remedy;
-  std::vector<std::string> summary, notes;
+  std::vector<std::string> summary, notes, warnings;
   std::vector<report::Figure> sigmas, residuals;
 };
 

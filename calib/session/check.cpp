@@ -16,7 +16,9 @@
 #include "rigcal/core/error.h"
 #include "rigcal/core/stats.h"
 #include "rigcal/core/version.h"
+#include "rigcal/report/json.h"
 #include "rigcal/session/provenance.h"
+#include "rigcal/session/report_html.h"
 
 namespace rigcal::session {
 namespace {
@@ -116,6 +118,46 @@ std::vector<Quantity> quantities(const std::vector<StepRecord>& records, const r
   return out;
 }
 
+// A residual figure of a step by its key in rigcal.steps (figure_key), NaN when absent.
+double figure_value(const std::vector<report::Figure>& figures, const std::string& key) {
+  for (const report::Figure& f : figures)
+    if (figure_key(f) == key) return f.value;
+  return NAN;
+}
+
+// The new data at the stored parameters, from the re-estimate's steps (which fitted them with
+// fit_at_rig), beside the stored calibration's levels and the re-estimate's.
+std::vector<ResidualLevel> residual_levels(const rig::Rig& stored,
+                                           const CalibrateResult& estimate) {
+  const std::vector<StepRecord> records = read_steps(stored);
+  struct Row {
+    const char *step, *what, *unit, *at_stored, *level;
+    double scale;
+  };
+  static const Row kRows[] = {
+      {"cameras", "corner reprojection RMS", "px", "rms_2d_at_rig_px", "rms_2d_px", 1},
+      {"lidar_camera", "boards' noise scale (1: as their covariances say)", "",
+       "noise_scale_at_rig", "noise_scale", 1},
+      {"lidar_camera", "board normal angle RMS", "deg", "normal_angle_rms_at_rig_deg", "", 1},
+      {"lidar_camera", "board distance RMS", "mm", "distance_rms_at_rig_m", "", 1e3}};
+  std::vector<ResidualLevel> out;
+  for (const Row& row : kRows) {
+    const auto run = std::find_if(estimate.steps.begin(), estimate.steps.end(),
+                                  [&](const StepRun& s) { return s.step == row.step; });
+    if (run == estimate.steps.end() || run->status != "ok") continue;
+    const double at = figure_value(run->residuals, row.at_stored);
+    if (!std::isfinite(at)) continue;
+    ResidualLevel l{row.step, row.what, row.unit, row.scale * at, NAN, NAN};
+    if (*row.level) {
+      l.reestimated = row.scale * figure_value(run->residuals, row.level);
+      for (const StepRecord& r : records)
+        if (r.step == row.step) l.stored = row.scale * figure_value(r.residuals, row.level);
+    }
+    out.push_back(l);
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string_view to_string(VerdictKind kind) {
@@ -147,6 +189,8 @@ CheckResult check(const rig::Rig& stored, const std::filesystem::path& stored_fi
   out.alarm_p = options.alarm_p;
   CalibrateOptions run = options.calibrate;
   run.rig = stored_file;
+  // The new data at the stored parameters too, beside their re-estimate.
+  run.cameras.fit_at_rig = run.lidar_camera.fit_at_rig = true;
   out.estimate = calibrate(run, progress);
 
   // The re-estimate with its own steps' sigmas (those that ended ok) in place of the stored ones.
@@ -336,6 +380,7 @@ CheckResult check(const rig::Rig& stored, const std::filesystem::path& stored_fi
   out.suspects.assign(suspects.begin(), suspects.end());
   const int run_status = out.estimate.exit_status;
   out.exit_status = any_changed ? 3 : (run_status == 1 || run_status == 2) ? run_status : 0;
+  out.residual_levels = residual_levels(stored, out.estimate);
   return out;
 }
 
@@ -360,6 +405,15 @@ nlohmann::json check_json(const CheckResult& r) {
                      {"reason", s.reason},
                      {"remedy", s.remedy}});
   }
+  nlohmann::json levels = nlohmann::json::array();
+  for (const ResidualLevel& l : r.residual_levels) {
+    levels.push_back({{"step", l.step},
+                      {"what", l.what},
+                      {"unit", l.unit},
+                      {"at_stored", report::finite_or_null(l.at_stored)},
+                      {"stored", report::finite_or_null(l.stored)},
+                      {"reestimated", report::finite_or_null(l.reestimated)}});
+  }
   nlohmann::json hypotheses = nlohmann::json::array();
   for (const Hypothesis& h : r.hypotheses) {
     hypotheses.push_back(
@@ -370,6 +424,7 @@ nlohmann::json check_json(const CheckResult& r) {
           {"tool_version", version_string()},
           {"alarm_p", r.alarm_p},
           {"verdicts", verdicts},
+          {"residual_levels", levels},
           {"hypotheses", hypotheses},
           {"suspects", r.suspects},
           {"likelihood_ratio",
@@ -391,6 +446,17 @@ std::vector<std::string> check_lines(const CheckResult& r) {
                           v.change, v.chi2, v.dof, v.p_value, v.detectable);
     }
     out.push_back(line);
+  }
+  if (!r.residual_levels.empty()) {
+    out.push_back("The new data at the stored calibration (only the boards' poses free):");
+    auto value = [](double v, const std::string& unit) {
+      return std::isfinite(v) ? fmt::format("{:.4g}{}", v, unit.empty() ? "" : " " + unit) : "-";
+    };
+    for (const ResidualLevel& l : r.residual_levels) {
+      out.push_back(fmt::format("  {:<12} {}: {} (the calibration's own {}, re-estimated {})",
+                                l.step, l.what, value(l.at_stored, l.unit), value(l.stored, l.unit),
+                                value(l.reestimated, l.unit)));
+    }
   }
   if (!r.hypotheses.empty()) {
     std::vector<std::string> tried;

@@ -8,6 +8,7 @@
 //   cannot tell  the new data do not determine it (its step did not end ok, or the new sigma is
 //                many times the stored one): what to record instead.
 // The sensors every changed quantity involves are named as the suspects.
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -56,12 +57,21 @@ struct Hypothesis {
   int dof = 0;                   // those components less the 6 of the fitted move
 };
 
+// A residual level of the new data at the stored parameters (nothing re-estimated but the
+// boards' poses), beside the stored calibration's own level and the re-estimate's on the new
+// data: a lens bumped shows as reprojection errors above both. NaN where not available.
+struct ResidualLevel {
+  std::string step, what, unit;
+  double at_stored = NAN, stored = NAN, reestimated = NAN;
+};
+
 struct CheckResult {
   std::filesystem::path calibration, session;  // what was checked against what
   double alarm_p = 1e-3;
   CalibrateResult estimate;  // the steps on the new session
   RigDifference difference;  // the stored calibration (A) against the re-estimate (B)
   std::vector<Verdict> verdicts;
+  std::vector<ResidualLevel> residual_levels;
   // Where a relation changed: each sensor of the changed relations, moved alone, best first.
   std::vector<Hypothesis> hypotheses;
   // How much likelier the best hypothesis is than the next, exp((chi2_2 - chi2_1) / 2) (infinite
@@ -87,17 +97,8 @@ nlohmann::json check_json(const CheckResult& result);
 // Lines for people: one a quantity, the suspects, the exit status's meaning.
 std::vector<std::string> check_lines(const CheckResult& result);
 
-// The page a person reads (report.html), rendered from check.json alone and the projection maps
-// (`figures`: each map's file name and SVG text), so that `rigcal report DIR` renders it again.
-std::string check_html(const nlohmann::json& check,
-                       const std::vector<std::pair<std::string, std::string>>& figures);
-
 // The report of a check in `dir`: check.json, diff.json, the projection maps, report.html.
 std::vector<io::OutputFile> check_report_files(const CheckResult& result,
                                                const std::filesystem::path& dir);
-
-// DIR/report.html rendered again from what a run stored in DIR (check.json, else diff.json, and
-// the projection maps). Throws rigcal::Error when DIR holds neither, or one rigcal did not write.
-io::OutputFile render_report(const std::filesystem::path& dir);
 
 }  // namespace rigcal::session

@@ -16,6 +16,7 @@
 #include "rigcal/core/stats.h"
 #include "rigcal/report/svg_plot.h"
 #include "rigcal/session/provenance.h"
+#include "rigcal/session/report_html.h"
 
 namespace rigcal::session {
 namespace {

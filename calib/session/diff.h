@@ -94,12 +94,6 @@ RigDifference diff_rigs(const rig::Rig& a, const rig::Rig& b, const DiffConfig& 
 nlohmann::json diff_json(const RigDifference& d);
 // Lines for people: a table of poses, clocks and cameras, each with its sigmas where stored.
 std::vector<std::string> diff_lines(const RigDifference& d);
-// The page a person reads (report.html) from diff.json and the projection maps (`figures`: file
-// name and SVG text); diff_html_sections is its body, which check's page includes.
-std::string diff_html(const nlohmann::json& diff,
-                      const std::vector<std::pair<std::string, std::string>>& figures);
-std::string diff_html_sections(const nlohmann::json& diff,
-                               const std::vector<std::pair<std::string, std::string>>& figures);
 // Each camera's map: projection_diff_<camera>.svg (the fitted difference over the image, with
 // its colour bar), by file name.
 std::vector<std::pair<std::string, std::string>> projection_maps(const RigDifference& d);

@@ -1,5 +1,7 @@
 // The pages a person reads for `rigcal diff` and `rigcal check` (diff.h, check.h), rendered from
 // their stored JSON: every number with its unit and what it means, the verdicts first.
+#include "rigcal/gt/report_html.h"
+
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
@@ -12,21 +14,20 @@
 #include "rigcal/report/html.h"
 #include "rigcal/session/check.h"
 #include "rigcal/session/diff.h"
+#include "rigcal/session/report_html.h"
 
 namespace rigcal::session {
 namespace {
 
 using report::html_escape;
-using Figures = std::vector<std::pair<std::string, std::string>>;
+using Figures = NamedFigures;
 
-std::string num(const nlohmann::json& v, const char* format) {
-  if (!v.is_number()) return "-";
-  return fmt::format(fmt::runtime(format), v.get<double>());
-}
+using report::html_number;
 
 // "x, y, z" of a 3-vector.
 std::string triple(const nlohmann::json& v, const char* format) {
-  return fmt::format("{}, {}, {}", num(v[0], format), num(v[1], format), num(v[2], format));
+  return fmt::format("{}, {}, {}", html_number(v[0], format), html_number(v[1], format),
+                     html_number(v[2], format));
 }
 
 std::string significance_text(const nlohmann::json& s) {
@@ -50,10 +51,11 @@ std::string diff_html_sections(const nlohmann::json& d, const Figures& figures) 
       html_escape(d["base_frame"].get<std::string>()));
   std::vector<std::vector<std::string>> rows;
   for (const nlohmann::json& p : d["poses"]) {
-    rows.push_back({"<code>" + html_escape(p["relation"].get<std::string>()) + "</code>",
-                    triple(p["rotation_deg"], "{:.4f}"), num(p["rotation_angle_deg"], "{:.4f}"),
-                    triple(p["translation_mm"], "{:.2f}"), num(p["translation_norm_mm"], "{:.2f}"),
-                    significance_text(p["significance"])});
+    rows.push_back(
+        {"<code>" + html_escape(p["relation"].get<std::string>()) + "</code>",
+         triple(p["rotation_deg"], "{:.4f}"), html_number(p["rotation_angle_deg"], "{:.4f}"),
+         triple(p["translation_mm"], "{:.2f}"), html_number(p["translation_norm_mm"], "{:.2f}"),
+         significance_text(p["significance"])});
   }
   out += report::html_table({"relation", "rotation x, y, z [deg]", "angle [deg]",
                              "translation x, y, z [mm]", "norm [mm]", "significance"},
@@ -64,8 +66,9 @@ std::string diff_html_sections(const nlohmann::json& d, const Figures& figures) 
       "ppm.</p>\n";
   rows.clear();
   for (const nlohmann::json& c : d["clocks"]) {
-    rows.push_back({html_escape(c["sensor"].get<std::string>()), num(c["offset_ms"], "{:+.4f}"),
-                    num(c["drift_ppm"], "{:+.3f}"), significance_text(c["significance"])});
+    rows.push_back({html_escape(c["sensor"].get<std::string>()),
+                    html_number(c["offset_ms"], "{:+.4f}"), html_number(c["drift_ppm"], "{:+.3f}"),
+                    significance_text(c["significance"])});
   }
   out += report::html_table({"sensor", "offset [ms]", "drift [ppm]", "significance"}, rows);
   out +=
@@ -88,10 +91,11 @@ std::string diff_html_sections(const nlohmann::json& d, const Figures& figures) 
     }
     out += report::html_table(
         {"projection difference", "rms [px]", "max [px]"},
-        {{"raw (the same rays)", num(p["raw_rms_px"], "{:.3f}"), num(p["raw_max_px"], "{:.3f}")},
+        {{"raw (the same rays)", html_number(p["raw_rms_px"], "{:.3f}"),
+          html_number(p["raw_max_px"], "{:.3f}")},
          {fmt::format("the camera's rotation taken out ({:.4f} deg)",
                       p["fitted_rotation_deg"].get<double>()),
-          num(p["fitted_rms_px"], "{:.3f}"), num(p["fitted_max_px"], "{:.3f}")}});
+          html_number(p["fitted_rms_px"], "{:.3f}"), html_number(p["fitted_max_px"], "{:.3f}")}});
     const std::string file = fmt::format("projection_diff_{}.svg", name);
     for (const auto& [figure, svg] : figures) {
       if (figure != file) continue;
@@ -154,12 +158,32 @@ std::string check_html(const nlohmann::json& c, const Figures& figures) {
                     verdict == "cannot tell"
                         ? "-"
                         : fmt::format("{:.2f} / {}", v["chi2"].get<double>(), v["dof"].get<int>()),
-                    verdict == "cannot tell" ? "-" : num(v["p_value"], "{:.3g}"),
+                    verdict == "cannot tell" ? "-" : html_number(v["p_value"], "{:.3g}"),
                     html_escape(v["detectable"].get<std::string>())});
   }
   body += report::html_table({"quantity", "step", "verdict", "change (or why not)", "chi² / dof",
                               "p", "smallest change flagged"},
                              rows);
+  if (c.contains("residual_levels") && !c["residual_levels"].empty()) {
+    body +=
+        "<h2 id=\"levels\">The new data at the stored calibration</h2>\n<p>The new session's "
+        "boards fitted with the stored parameters held (only the boards' poses free), beside the "
+        "level the calibration reached on its own data and the level the re-estimate reaches on "
+        "the new data. A bumped lens or a moved sensor shows as a level at the stored "
+        "calibration above both.</p>\n";
+    rows.clear();
+    for (const nlohmann::json& l : c["residual_levels"]) {
+      const std::string unit = l["unit"];
+      rows.push_back(
+          {html_escape(l["step"].get<std::string>()),
+           html_escape(l["what"].get<std::string>() + (unit.empty() ? "" : " [" + unit + "]")),
+           html_number(l["at_stored"], "{:.4g}"), html_number(l["stored"], "{:.4g}"),
+           html_number(l["reestimated"], "{:.4g}")});
+    }
+    body += report::html_table({"step", "residual", "at the stored calibration",
+                                "the calibration's own", "re-estimated on the new data"},
+                               rows);
+  }
   if (!c["hypotheses"].empty()) {
     body +=
         "<h2 id=\"which\">Which sensor moved</h2>\n<p>Each sensor of the changed relations "
@@ -170,7 +194,7 @@ std::string check_html(const nlohmann::json& c, const Figures& figures) {
     for (const nlohmann::json& h : c["hypotheses"]) {
       rows.push_back({html_escape(h["sensor"].get<std::string>()),
                       fmt::format("{:.2f} / {}", h["chi2"].get<double>(), h["dof"].get<int>()),
-                      num(h["p_value"], "{:.3g}")});
+                      html_number(h["p_value"], "{:.3g}")});
     }
     body += report::html_table({"moved alone", "chi² / dof", "p"}, rows);
     if (c["hypotheses"].size() > 1 && c["likelihood_ratio"].is_number()) {
@@ -206,6 +230,20 @@ io::OutputFile render_report(const std::filesystem::path& dir) {
     }
   }
   std::sort(figures.begin(), figures.end());
+  if (fs::exists(dir / "reports" / "calibrate.json"))
+    return {dir / "report.html", calibrate_html(dir)};
+  if (fs::exists(dir / "ground_truth.json")) {
+    const fs::path top = dir / "trajectory_top.svg";
+    try {
+      return {dir / "report.html",
+              gt::ground_truth_html(
+                  nlohmann::json::parse(io::read_text_file(dir / "ground_truth.json")),
+                  fs::exists(top) ? io::read_text_file(top) : "")};
+    } catch (const nlohmann::json::exception& e) {
+      throw Error(fmt::format("{}: not a report rigcal wrote: {}",
+                              (dir / "ground_truth.json").string(), e.what()));
+    }
+  }
   for (const char* name : {"check.json", "diff.json"}) {
     const fs::path json = dir / name;
     if (!fs::exists(json)) continue;
@@ -219,8 +257,9 @@ io::OutputFile render_report(const std::filesystem::path& dir) {
     }
   }
   throw Error(
-      fmt::format("{}: no check.json or diff.json to render (rigcal check and rigcal diff "
-                  "write them with --report)",
+      fmt::format("{}: no reports/calibrate.json, ground_truth.json, check.json or diff.json to "
+                  "render (rigcal calibrate writes the first in its --out folder, rigcal "
+                  "ground-truth, check and diff the others with --report)",
                   dir.string()));
 }
 

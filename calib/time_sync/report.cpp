@@ -7,6 +7,7 @@
 #include "rigcal/core/se3.h"
 #include "rigcal/core/version.h"
 #include "rigcal/report/json.h"
+#include "rigcal/report/rotation.h"
 #include "rigcal/report/svg_plot.h"
 
 namespace rigcal::time_sync {
@@ -72,6 +73,7 @@ nlohmann::json time_sync_json(const TimeSyncResult& r, const TimeSyncOptions& o,
     j["three_axis"] = {{"enabled", r.three_axis},
                        {"model", "w_reference = R_reference_other * w_other + bias_difference"},
                        {"R_reference_other", R},
+                       {"axis_angle", report::axis_angle_json(r.R_reference_other)},
                        {"roll_pitch_yaw_deg", {rpy.x(), rpy.y(), rpy.z()}},
                        {"bias_difference_rad_s",
                         {r.bias_difference.x(), r.bias_difference.y(), r.bias_difference.z()}},

@@ -10,6 +10,7 @@
 #include "rigcal/core/text.h"
 #include "rigcal/io/files.h"
 #include "rigcal/io/session.h"
+#include "rigcal/report/rotation.h"
 #include "rigcal/rig/rig_yaml.h"
 #include "rigcal/time_sync/report.h"
 
@@ -166,11 +167,12 @@ report::StepResult estimate_clock(const StepInputs& in, const TimeSyncOptions& t
       "peak: NCC {:.3f}, second peak {:.3f} at {:+.4f} s (ratio {:.2f}); overlap {:.1f} s",
       r.peak_ncc, r.second_peak_ncc, r.second_peak_offset_s, r.peak_ratio, r.overlap_s));
   if (r.three_axis) {
-    const Eigen::Vector3d rpy = roll_pitch_yaw(r.R_reference_other) * 180.0 / M_PI;
+    const nlohmann::json aa = report::axis_angle_json(r.R_reference_other);
     out.summary.push_back(fmt::format(
-        "rotation other -> reference (roll pitch yaw): {:.3f} {:.3f} {:.3f} deg; residual RMS "
+        "rotation other -> reference: {:.3f} deg about [{:.4f} {:.4f} {:.4f}]; residual RMS "
         "{:.4f} rad/s",
-        rpy.x(), rpy.y(), rpy.z(), r.residual_rms_rad_s));
+        aa["angle_deg"].get<double>(), aa["axis"][0].get<double>(), aa["axis"][1].get<double>(),
+        aa["axis"][2].get<double>(), r.residual_rms_rad_s));
   }
   if (r.drift_estimated) {
     out.summary.push_back(fmt::format(

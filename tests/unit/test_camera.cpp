@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 
@@ -471,6 +472,56 @@ TEST(CameraDetect, AprilGridCornersMatchTruth) {
   EXPECT_GE(tags, part.left.size() * 36 / 2);
   EXPECT_LT(median(errors), 0.1);
   EXPECT_LT(errors[errors.size() * 9 / 10], 0.3);
+}
+
+}  // namespace
+}  // namespace rigcal::camera
+
+namespace rigcal::camera {
+namespace {
+
+// Corners on a grid of the 1200 x 600 image, except where `skip` says.
+CalibrationResult corners_where(const std::function<bool(double u, double v)>& skip) {
+  CalibrationResult r;
+  for (double u = 10; u < 1200; u += 40) {
+    for (double v = 10; v < 600; v += 40) {
+      if (skip(u, v)) continue;
+      CornerResidual c;
+      c.observed = {u, v};
+      r.residuals.push_back(c);
+    }
+  }
+  return r;
+}
+
+TEST(CameraReport, CoverageWarningsNameWhereTheImageHasNoCorners) {
+  EXPECT_TRUE(
+      coverage_warnings(corners_where([](double, double) { return false; }), 0, "cam_r", 1200, 600)
+          .empty());
+  const std::vector<std::string> half = coverage_warnings(
+      corners_where([](double u, double) { return u > 560; }), 0, "cam_r", 1200, 600);
+  ASSERT_EQ(half.size(), 1u);
+  EXPECT_NE(half[0].find("cam_r: the right half of the image holds 0 of its"), std::string::npos)
+      << half[0];
+  // An outlier corner is no coverage; another camera's corners are not this one's.
+  CalibrationResult r = corners_where([](double u, double v) { return u < 400 && v < 200; });
+  CornerResidual stray;
+  stray.observed = {50, 50};
+  stray.outlier = true;
+  r.residuals.push_back(stray);
+  stray.outlier = false, stray.camera = 1;
+  r.residuals.push_back(stray);
+  const std::vector<std::string> ninth = coverage_warnings(r, 0, "cam_l", 1200, 600);
+  ASSERT_EQ(ninth.size(), 1u);
+  EXPECT_NE(ninth[0].find("cam_l: no corners in the top-left ninth"), std::string::npos)
+      << ninth[0];
+  // The corners and their residuals as the report's CSV.
+  r.residuals[0].residual = {0.25, -0.5};
+  const std::string csv = residuals_csv(r, {"cam_l", "cam_r"});
+  EXPECT_EQ(csv.substr(0, csv.find('\n', csv.find('\n') + 1) + 1),
+            "camera,view,point,u_px,v_px,residual_u_px,residual_v_px,outlier\n"
+            "cam_l,0,0,10.000,210.000,0.25000,-0.50000,0\n");
+  EXPECT_NE(csv.find("cam_r,0,0,50.000,50.000"), std::string::npos);
 }
 
 }  // namespace

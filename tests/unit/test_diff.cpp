@@ -6,14 +6,21 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "browser.h"
 #include "cli_run.h"
 #include "rigcal/core/error.h"
 #include "rigcal/core/stats.h"
+#include "rigcal/report/html.h"
+#include "rigcal/report/png.h"
+#include "rigcal/report/rotation.h"
+#include "rigcal/report/svg_plot.h"
 #include "rigcal/rig/export.h"
 #include "rigcal/rig/rig_yaml.h"
 #include "rigcal/session/diff.h"
@@ -294,8 +301,77 @@ TEST(DiffReport, LoadsInChromiumAndRendersAgainFromItsJson) {
   EXPECT_EQ(testing::slurp(dir / "report/report.html"), page);
   r = testing::rigcal_cli(fmt::format("report {}", dir.string()), dir);
   EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.err.find("no check.json or diff.json"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("no reports/calibrate.json, ground_truth.json, check.json or diff.json"),
+            std::string::npos)
+      << r.err;
   fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rigcal
+
+namespace rigcal {
+namespace {
+
+TEST(ReportHtml, RotationsAreAnAngleAboutAnAxisEvenAtGimbalLock) {
+  const Eigen::Vector3d axis = Eigen::Vector3d(1, -1, 1).normalized();
+  const Eigen::Matrix3d R = rotation_from_vector(axis * 120 * M_PI / 180);
+  const nlohmann::json aa = report::axis_angle_json(R);
+  EXPECT_NEAR(aa["angle_deg"].get<double>(), 120, 1e-10);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(aa["axis"][i].get<double>(), axis[i], 1e-12);
+  EXPECT_EQ(report::rotation_text(R, {0.01, 0.02, 0.03}, "cam_r"),
+            "rotation 120.0000 deg about [0.5774 -0.5774 0.5774], 1-sigma 0.0100 0.0200 0.0300 "
+            "deg about cam_r's x y z");
+  EXPECT_EQ(report::axis_angle_json(Eigen::Matrix3d::Identity())["angle_deg"], 0.0);
+  // A camera looking along the LiDAR's x (pitch 90 deg, where roll and yaw are one angle): its
+  // angle and axis give the rotation back.
+  const Eigen::Matrix3d lock = from_roll_pitch_yaw(0.3, M_PI / 2, -0.2);
+  const nlohmann::json l = report::axis_angle_json(lock);
+  const Eigen::Vector3d phi(l["axis"][0].get<double>(), l["axis"][1].get<double>(),
+                            l["axis"][2].get<double>());
+  EXPECT_TRUE(
+      rotation_from_vector(phi * l["angle_deg"].get<double>() * M_PI / 180).isApprox(lock, 1e-12));
+}
+
+std::string base64_decode(std::string_view text) {
+  std::string out;
+  uint32_t v = 0;
+  int bits = 0;
+  for (const char c : text) {
+    const char* digits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    const char* at = std::strchr(digits, c);
+    if (c == '=' || !at) break;
+    v = v << 6 | static_cast<uint32_t>(at - digits), bits += 6;
+    if (bits >= 8) out += static_cast<char>((v >> (bits - 8)) & 0xff), bits -= 8;
+  }
+  return out;
+}
+
+TEST(ReportHtml, ImagesShrinkIntoThePageAndEachPlotClipsOnItsOwn) {
+  cv::Mat image(1000, 2000, CV_8UC3);
+  cv::randu(image, 0, 255);
+  const std::string html = report::html_inline_image(report::encode_png(image), "shot <1>");
+  const std::string prefix = "<img src=\"data:image/jpeg;base64,";
+  ASSERT_EQ(html.rfind(prefix, 0), 0u) << html.substr(0, 80);
+  EXPECT_NE(html.find("width=\"1000\" alt=\"shot &lt;1&gt;\""), std::string::npos);
+  const std::string jpeg = base64_decode(html.substr(prefix.size()));
+  const cv::Mat back = cv::imdecode(std::vector<uchar>(jpeg.begin(), jpeg.end()), cv::IMREAD_COLOR);
+  EXPECT_EQ(back.cols, 1000);
+  EXPECT_EQ(back.rows, 500);
+  EXPECT_THROW(report::html_inline_image("not an image", "x"), Error);
+
+  report::Plot a{"a", "x", "y", "", {{"s", {0, 1}, {0, 1}, {}}}};
+  report::Plot b = a;
+  b.title = "b";
+  const std::string sa = report::html_inline_svg(report::render_svg(a)),
+                    sb = report::html_inline_svg(report::render_svg(b));
+  auto clip = [](const std::string& svg) {
+    const size_t at = svg.find("clipPath id=\"") + 13;
+    return svg.substr(at, svg.find('"', at) - at);
+  };
+  EXPECT_NE(clip(sa), clip(sb));
+  EXPECT_NE(sa.find("url(#" + clip(sa) + ")"), std::string::npos);
+  EXPECT_EQ(sa.find("url(#area)"), std::string::npos);
 }
 
 }  // namespace

@@ -743,6 +743,17 @@ TEST(GroundTruthCli, WritesVbrsFormatAndSigmasRefusesBadInputAndSaysWhatIsUndete
       nlohmann::json::parse(testing::slurp(dir / "report/ground_truth.json"));
   EXPECT_EQ(report["summary"]["poses"].get<size_t>(), s.truth_enu.size());
   EXPECT_EQ(report["priors"].size(), report["summary"]["priors"].get<size_t>());
+  // The page a person reads beside the JSON (no markers here: the sigmas are the word), with
+  // the top view; `rigcal report` renders it again the same from the two.
+  const std::string page = testing::slurp(dir / "report/report.html");
+  EXPECT_NE(page.find("No markers surveyed"), std::string::npos);
+  for (const char* text : {"id=\"summary\"", "id=\"priors\"", "The ground truth from above",
+                           "The GNSS priors' residuals"})
+    EXPECT_NE(page.find(text), std::string::npos) << text;
+  EXPECT_TRUE(fs::exists(dir / "report/trajectory_top.svg"));
+  fs::remove(dir / "report/report.html");
+  EXPECT_EQ(testing::rigcal_cli(fmt::format("report {}/report", dir.string()), dir).status, 0);
+  EXPECT_EQ(testing::slurp(dir / "report/report.html"), page);
   // Read back, against the truth.
   const Trajectory gt = io::read_trajectory(dir / "seq_gt.txt").trajectory;
   ASSERT_EQ(gt.size(), s.truth_enu.size());
@@ -781,6 +792,10 @@ TEST(GroundTruthCli, WritesVbrsFormatAndSigmasRefusesBadInputAndSaysWhatIsUndete
   EXPECT_NE(r.err.find("undetermined: every pose"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "y_gt.txt"));
   EXPECT_TRUE(fs::exists(dir / "late_report/ground_truth.json"));
+  // Its page says what is undetermined first.
+  const std::string late_page = testing::slurp(dir / "late_report/report.html");
+  EXPECT_NE(late_page.find("the data do not determine"), std::string::npos);
+  EXPECT_NE(late_page.find("<ul class=\"warning\">"), std::string::npos);
   // The same fixes as a CSV (RTK fixed, the default sigmas) at a given origin with --enu-origin:
   // the same trajectory, in the same frame.
   const std::vector<Eigen::Vector3d> sd(s.part.gnss.size(), Eigen::Vector3d(0.02, 0.02, 0.03));

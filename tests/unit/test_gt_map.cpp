@@ -257,6 +257,12 @@ TEST(GroundTruthSim, AShortWalksMarkersAndTrajectoryAgainstTheTruth) {
   // say so.
   EXPECT_LT(s.ate_rms_m, 0.035);
   EXPECT_GE(s.within_3_sigma, 0.95);
+  // The page leads with the markers against VBR's bar, pair by pair, and the adjustment's windows.
+  const std::string page = testing::slurp(dir / "report/report.html");
+  EXPECT_NE(page.find("Markers: 6 of 6 found; their distances agree with the survey"),
+            std::string::npos);
+  EXPECT_NE(page.find("id=\"markers\""), std::string::npos);
+  EXPECT_NE(page.find("Points off their planes, each window"), std::string::npos);
   // The map: a binary PLY of the report's points.
   const std::string ply = testing::slurp(dir / "map.ply");
   EXPECT_EQ(ply.rfind("ply\nformat binary_little_endian 1.0\n", 0), 0u);

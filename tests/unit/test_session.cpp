@@ -20,6 +20,7 @@
 #include <sstream>
 
 #include "bag_writer.h"
+#include "browser.h"
 #include "cli_run.h"
 #include "devkit_layout.h"
 #include "fixtures.h"
@@ -134,7 +135,6 @@ class Session : public ::testing::Test {
   fs::path dir_;
 };
 
-
 double rotation_error_deg(const SE3& a, const SE3& b) {
   return rotation_angle(a.R.transpose() * b.R) * 180.0 / M_PI;
 }
@@ -232,6 +232,9 @@ TEST_F(Session, CalibrateNamesTheFailedStepThenRerunsOnlyIt) {
     ASSERT_TRUE(fs::exists(json)) << step;
     EXPECT_EQ(nlohmann::json::parse(slurp(json))["status"], "ok") << step;
   }
+  // The page a person reads says so first, and names the failed step's reason.
+  const std::string bad_page = slurp(out / "report.html");
+  EXPECT_NE(bad_page.find("Nothing published: lidar_camera failed"), std::string::npos);
 
   fs::remove_all(images);
   fs::copy(kept, images);
@@ -242,6 +245,31 @@ TEST_F(Session, CalibrateNamesTheFailedStepThenRerunsOnlyIt) {
     EXPECT_NE(fixed.out.find(fmt::format("== {}: ok (cached", step)), std::string::npos) << step;
   std::printf("[ figures ] failing run %.1f s, rerun after the fix %.1f s\n", bad.seconds,
               fixed.seconds);
+  // One page: the verdict, each step's section with its numbers and figures (the cached steps'
+  // from their stored reports), rendered again the same from OUT/reports/ alone.
+  const std::string page = slurp(out / "report.html");
+  EXPECT_NE(page.find("Published <code>"), std::string::npos);
+  for (const char* id : {"id=\"steps\"", "id=\"step-cameras\"", "id=\"step-lidar_camera\"",
+                         "id=\"step-time_sync\"", "id=\"step-hand_eye\""})
+    EXPECT_NE(page.find(id), std::string::npos) << id;
+  for (const char* text : {"cam_l: inlier corners' |residual|, RMS", "cam_r: residual vectors",
+                           "<b>T_cam_r_lidar</b>", "The offset in each window",
+                           "<b>T_gnss_lidar</b>", "Each pair's chi-square", "data:image/jpeg"})
+    EXPECT_NE(page.find(text), std::string::npos) << text;
+  EXPECT_EQ(page.find("roll"), std::string::npos) << "rotations as angle and axis only";
+  EXPECT_LT(page.size(), 8u << 20) << "the camera images scaled down";
+  fs::remove(out / "report.html");
+  const CliRun again = rigcal_cli(fmt::format("report {}", out.string()), dir_);
+  EXPECT_EQ(again.status, 0) << again.err;
+  EXPECT_EQ(slurp(out / "report.html"), page);
+  if (testing::have_chromium()) {
+    const testing::BrowserLoad load =
+        testing::load_in_browser(out / "report.html", dir_ / "calibrate.png");
+    EXPECT_TRUE(load.ran) << load.log;
+    EXPECT_EQ(testing::console_messages(load.log), "");
+    EXPECT_NE(load.dom.find("id=\"step-hand_eye\""), std::string::npos);
+    EXPECT_GT(load.screenshot_bytes, 20000u);
+  }
 
   // The calibration against the truth, sensor by sensor, at the bars of the steps' issues.
   const rig::Rig cal = rig::read_rig_file(out / "calib.yaml");
