@@ -140,6 +140,12 @@ nlohmann::json cameras_json(const CalibrationResult& r, const CameraReportInput&
                                       {"mean_px", u.mean_px},
                                       {"max_px", u.max_px},
                                       {"centre_px", u.centre_px}};
+      // The map itself, for the report's figure: cells of cell_px from the image's corner, rows
+      // first, each sigma to 4 digits.
+      nlohmann::json sigma = nlohmann::json::array();
+      for (const double s : u.sigma_px) sigma.push_back(std::stod(fmt::format("{:.4g}", s)));
+      cj["projection_uncertainty"]["grid"] = {
+          {"cols", u.cols}, {"rows", u.rows}, {"cell_px", u.cell_px}, {"sigma_px", sigma}};
       if (c < in.uncertainty_intrinsics_only.size()) {
         const UncertaintyMap& ui = in.uncertainty_intrinsics_only[c];
         cj["projection_uncertainty"]["intrinsics_only_mean_px"] = ui.mean_px;

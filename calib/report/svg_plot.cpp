@@ -74,6 +74,14 @@ Bounds bounds(const Plot& plot, double pw, double ph) {
       if (std::isfinite(v)) v0 = std::min(v0, v), v1 = std::max(v1, v);
     }
   }
+  if (plot.grid) {
+    const PlotGrid& g = *plot.grid;
+    x0 = std::min(x0, g.x0), x1 = std::max(x1, g.x0 + g.cols * g.cell);
+    y0 = std::min(y0, g.y0), y1 = std::max(y1, g.y0 + g.rows * g.cell);
+    for (double v : g.values) {
+      if (std::isfinite(v)) v0 = std::min(v0, v), v1 = std::max(v1, v);
+    }
+  }
   if (!std::isfinite(x0)) x0 = 0, x1 = 1, y0 = 0, y1 = 1;
   if (plot.limits.size() == 4)
     x0 = plot.limits[0], x1 = plot.limits[1], y0 = plot.limits[2], y1 = plot.limits[3];
@@ -94,6 +102,56 @@ Bounds bounds(const Plot& plot, double pw, double ph) {
     y0 = cy - ph / (2 * s), y1 = cy + ph / (2 * s);
   }
   return {x0, x1, y0, y1, v0, v1, sx, sy};
+}
+
+// The grid's cells, then its contour lines (marching squares over the cells' centres, a saddle
+// split the same way every time), as SVG in plot coordinates mapped by X and Y.
+template <typename FX, typename FY>
+std::string grid_svg(const PlotGrid& g, double v0, double v1, FX X, FY Y) {
+  std::string out;
+  auto at = [&](int c, int r) { return g.values[static_cast<size_t>(r) * g.cols + c]; };
+  for (int r = 0; r < g.rows; ++r) {
+    for (int c = 0; c < g.cols; ++c) {
+      const double xa = X(g.x0 + c * g.cell), xb = X(g.x0 + (c + 1) * g.cell);
+      const double ya = Y(g.y0 + r * g.cell), yb = Y(g.y0 + (r + 1) * g.cell);
+      const double f = v1 > v0 ? (at(c, r) - v0) / (v1 - v0) : 0.0;
+      out += fmt::format(
+          "<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"{:.1f}\" height=\"{:.1f}\" fill=\"{}\"/>\n",
+          std::min(xa, xb), std::min(ya, yb), std::abs(xb - xa) + 0.4, std::abs(yb - ya) + 0.4,
+          viridis(f));
+    }
+  }
+  for (const double level : g.contours) {
+    std::string path;
+    for (int r = 0; r + 1 < g.rows; ++r) {
+      for (int c = 0; c + 1 < g.cols; ++c) {
+        // The square's corners counter-clockwise and the crossings on its four edges.
+        const int cc[4] = {c, c + 1, c + 1, c}, rr[4] = {r, r, r + 1, r + 1};
+        std::vector<std::pair<double, double>> cross;
+        for (int e = 0; e < 4; ++e) {
+          const double a = at(cc[e], rr[e]), b = at(cc[(e + 1) % 4], rr[(e + 1) % 4]);
+          if (!std::isfinite(a) || !std::isfinite(b) || (a < level) == (b < level)) continue;
+          const double t = (level - a) / (b - a);
+          const double x = cc[e] + t * (cc[(e + 1) % 4] - cc[e]);
+          const double y = rr[e] + t * (rr[(e + 1) % 4] - rr[e]);
+          cross.emplace_back(g.x0 + (x + 0.5) * g.cell, g.y0 + (y + 0.5) * g.cell);
+        }
+        for (size_t k = 0; k + 1 < cross.size(); k += 2) {
+          path += fmt::format("M{:.1f} {:.1f}L{:.1f} {:.1f}", X(cross[k].first), Y(cross[k].second),
+                              X(cross[k + 1].first), Y(cross[k + 1].second));
+        }
+      }
+    }
+    if (path.empty()) continue;
+    // Labelled where the line starts (its first segment's first point).
+    double lx = 0, ly = 0;
+    std::sscanf(path.c_str(), "M%lf %lf", &lx, &ly);
+    out += fmt::format(
+        "<path d=\"{}\" fill=\"none\" stroke=\"white\" stroke-width=\"1.2\"/>\n<text x=\"{:.1f}\" "
+        "y=\"{:.1f}\" fill=\"white\" font-size=\"11\">{:g}</text>\n",
+        path, lx + 3, ly - 3, level);
+  }
+  return out;
 }
 
 }  // namespace
@@ -140,6 +198,7 @@ std::string render_svg(const Plot& plot) {
       "<clipPath id=\"area\"><rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\"/></clipPath>\n<g "
       "clip-path=\"url(#area)\">\n",
       kLeft, kTop, pw, ph);
+  if (plot.grid) out += grid_svg(*plot.grid, v0, v1, X, Y);
   for (size_t k = 0; k < plot.series.size(); ++k) {
     const PlotSeries& s = plot.series[k];
     const size_t stride = std::max<size_t>(1, s.x.size() / 4000);

@@ -2,6 +2,7 @@
 // Small SVG plots for reports: lines (one colour a series) or points coloured by a value with a
 // colour bar. Enough for trajectory top views, errors along a trajectory and cumulative curves;
 // files open in any browser. Long series are thinned to at most 4000 points a series.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,16 @@ struct PlotSeries {
   std::vector<double> y_error = {};  // non-empty: markers with bars of +- these (1-sigma) in y
 };
 
+// A field over a regular grid (an image's cells): drawn as coloured cells (viridis, with the
+// colour bar) under the series, with contour lines at `contours` (marching squares over the
+// cells' centres). SVG only.
+struct PlotGrid {
+  int cols = 0, rows = 0;
+  double x0 = 0, y0 = 0, cell = 1;  // the first cell's corner and the cells' side (plot units)
+  std::vector<double> values;       // row-major, rows along y
+  std::vector<double> contours;     // levels, in the values' units
+};
+
 struct Plot {
   std::string title, x_label, y_label, value_label;
   std::vector<PlotSeries> series;
@@ -22,6 +33,7 @@ struct Plot {
   bool step = false;                // draw lines as steps (cumulative curves)
   bool y_down = false;              // y grows downwards (image rows)
   std::vector<double> limits = {};  // empty, or x0 x1 y0 y1: the axes' range (an image's extent)
+  std::optional<PlotGrid> grid = {};
 };
 
 std::string render_svg(const Plot& plot);

@@ -187,11 +187,46 @@ std::string camera_figures(const std::string& name, const json& cam,
                     "Counts of |residual| in 30 bins, and the Rayleigh curve that isotropic "
                     "Gaussian noise of the same RMS gives: a heavier tail is outliers the "
                     "rejection kept or a lens the model does not fit.");
-  out += png_figure(dir / (name + "_uncertainty.png"),
-                    fmt::format("{}: projection 1-sigma over the image (mrcal's definition, at the "
-                                "boards' median distance), yellow the largest; its figures in the "
-                                "table above.",
-                                html_escape(name)));
+  const json& u = cam["projection_uncertainty"];
+  if (u.is_object() && u.contains("grid")) {
+    const json& g = u["grid"];
+    report::PlotGrid grid;
+    grid.cols = g["cols"], grid.rows = g["rows"], grid.cell = g["cell_px"];
+    grid.values = g["sigma_px"].get<std::vector<double>>();
+    // Contours at 1-2-5 steps inside the map's range.
+    const auto [lo, hi] = std::minmax_element(grid.values.begin(), grid.values.end());
+    for (double decade = 1e-3; decade < 1e3; decade *= 10) {
+      for (const double m : {1.0, 2.0, 5.0}) {
+        if (m * decade > *lo && m * decade < *hi) grid.contours.push_back(m * decade);
+      }
+    }
+    report::Plot map{
+        fmt::format("{}: projection 1-sigma at {} m", name, html_number(u["distance_m"], "{:.2f}")),
+        "u [px]",
+        "v [px]",
+        "1-sigma [px]",
+        {},
+        true,
+        false,
+        true,
+        {0, w, 0, h}};
+    map.grid = grid;
+    map.series.push_back(inliers);
+    map.series.back().values.clear();
+    map.series.back().label = "corners";
+    map.series.back().points = true;
+    out += svg_figure(
+        map, fmt::format("{}: the 1-sigma of a pixel's projection over the image (mrcal's "
+                         "definition: the whole covariance, the boards' poses included, for a "
+                         "point at the boards' median distance), contours at 1-2-5 steps, the "
+                         "corners over it: it is small where the boards were.",
+                         html_escape(name)));
+  } else {
+    out += png_figure(dir / (name + "_uncertainty.png"),
+                      fmt::format("{}: projection 1-sigma over the image (mrcal's definition, at "
+                                  "the boards' median distance), yellow the largest.",
+                                  html_escape(name)));
+  }
   out +=
       png_figure(dir / (name + "_corners.png"),
                  fmt::format("{}: the corners detected on the first image that shows the target.",
@@ -572,9 +607,10 @@ std::string calibrate_html(const fs::path& out) {
   for (const json& s : run["steps"]) {
     std::vector<std::string> figures;
     for (const json& f : s["residuals"]) {
-      figures.push_back(fmt::format(
-          "{} {:.4g}{}", f["name"].get<std::string>(), f["value"].get<double>(),
-          f["unit"].get<std::string>().empty() ? "" : " " + f["unit"].get<std::string>()));
+      // (fmt, not operator+: GCC 12 warns falsely on `" " + string` here, -Wrestrict)
+      const std::string unit = f["unit"];
+      figures.push_back(fmt::format("{} {:.4g}{}{}", f["name"].get<std::string>(),
+                                    f["value"].get<double>(), unit.empty() ? "" : " ", unit));
     }
     const std::string step = s["step"];
     rows.push_back({fmt::format("<a href=\"#step-{0}\">{0}</a>", html_escape(step)),

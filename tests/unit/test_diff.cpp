@@ -374,5 +374,28 @@ TEST(ReportHtml, ImagesShrinkIntoThePageAndEachPlotClipsOnItsOwn) {
   EXPECT_EQ(sa.find("url(#area)"), std::string::npos);
 }
 
+TEST(ReportHtml, AGridIsDrawnCellByCellWithItsContours) {
+  // Values growing with the column: the 1.5 contour runs between columns 1 and 2's centres, at
+  // x = 20 in plot units (cells of 10), straight down the three rows' centres.
+  report::PlotGrid g;
+  g.cols = 4, g.rows = 3, g.cell = 10;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) g.values.push_back(c);
+  g.contours = {1.5};
+  report::Plot plot{"grid", "x", "y", "value", {}};
+  plot.limits = {0, 40, 0, 30};
+  plot.grid = g;
+  const std::string svg = report::render_svg(plot);
+  // 670 x 510 px of plot area from (80, 50): x 20 -> 415, y 5, 15, 25 -> 475, 305, 135.
+  EXPECT_NE(svg.find("<path d=\"M415.0 475.0L415.0 305.0M415.0 305.0L415.0 135.0\""),
+            std::string::npos)
+      << svg;
+  size_t cells = 0;
+  for (size_t at = svg.find("<rect x="); at != std::string::npos; at = svg.find("<rect x=", at + 1))
+    ++cells;
+  EXPECT_GE(cells, 12u);  // the cells, then the frame and the colour bar's
+  EXPECT_NE(svg.find(">1.5</text>"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace rigcal
