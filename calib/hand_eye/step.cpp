@@ -118,6 +118,7 @@ report::StepResult estimate(const StepInputs& in, const StepOptions& o, const Tr
   double offset_s = 0.0;
   SE3 T_base_lidar;
   std::optional<SE3> prior_T_gnss_lidar;
+  double prior_offset_s = 0;
   if (in.rig) {
     out.rig = *in.rig;
     const rig::Sensor* g = rig::find_sensor(*in.rig, o.sensor);
@@ -129,6 +130,7 @@ report::StepResult estimate(const StepInputs& in, const StepOptions& o, const Tr
     offset_s = g->time_offset - l->time_offset;
     T_base_lidar = l->T_base_sensor;
     prior_T_gnss_lidar = g->T_base_sensor.inverse() * T_base_lidar;
+    prior_offset_s = offset_s;
   }
   const io::TrajectoryReadOptions read = read_options(o);
   std::vector<std::string>& notes = out.notes;
@@ -344,7 +346,25 @@ report::StepResult estimate(const StepInputs& in, const StepOptions& o, const Tr
   out.residuals = {{"pairs", static_cast<double>(pairs.size()), ""},
                    {"outlier_pairs", static_cast<double>(outliers), ""},
                    {"noise_scale", r.noise_scale, ""},
-                   {"odometry_scale", r.odometry_scale, ""}};
+                   {"odometry_scale", r.odometry_scale, ""},
+                   {"pair_rotation_median_deg", median(r.pair_rotation_residual_deg), "deg"},
+                   {"pair_translation_median_m", median(r.pair_translation_residual_m), "m"}};
+  if (o.fit_at_rig && prior_T_gnss_lidar) {
+    // The same kind of pairs on the rig's clock, against its extrinsic: medians, robust to the
+    // odd outlier pair as the estimate's are.
+    PairOptions at = po;
+    at.time_offset_s = prior_offset_s;
+    std::vector<double> rot_deg, trans_m;
+    const SE3& Y = *prior_T_gnss_lidar;
+    for (const MotionPair& p : motion_pairs(lidar, gnss, at)) {
+      rot_deg.push_back(rotation_angle((Y.R * p.A.R).transpose() * (p.B.R * Y.R)) * 180 / M_PI);
+      trans_m.push_back((p.B.R * Y.t + p.B.t - Y.R * p.A.t - Y.t).norm());
+    }
+    if (!rot_deg.empty()) {
+      out.residuals.push_back({"pair_rotation_median_at_rig_deg", median(rot_deg), "deg"});
+      out.residuals.push_back({"pair_translation_median_at_rig_m", median(trans_m), "m"});
+    }
+  }
   return out;
 }
 

@@ -29,6 +29,10 @@ struct StepOptions {
   // And it estimates each sweep's own motion (lidar::OdometryConfig::estimate_sweep_motion): a
   // motion recording turns and walks the rig, which the motion of the step before lags.
   bool odometry_sweep_motion = true;
+  // Also the motion pairs' residuals at the given rig's T_gnss_lidar and clock offset (odometry
+  // scale 1), nothing re-estimated (rigcal check: the new motion at the stored calibration):
+  // the residual figures pair_*_median_at_rig_<unit>, beside the estimate's pair_*_median_<unit>.
+  bool fit_at_rig = false;
 };
 
 struct StepInputs {

@@ -314,7 +314,9 @@ std::string render_png(const Plot& plot) {
         pts.push_back(P(X(s.x[i]) - kLeft, Y(s.y[i]) - kTop));
     }
     if (!s.values.empty() || s.points || !s.y_error.empty()) {
-      for (size_t i = 0; i < pts.size(); ++i) cv::circle(area, pts[i], 2, colour(k), cv::FILLED);
+      const int radius = s.values.empty() && s.x.size() < 50 ? 5 : 2;  // a few marked points
+      for (size_t i = 0; i < pts.size(); ++i)
+        cv::circle(area, pts[i], radius, colour(k), cv::FILLED);
     } else if (pts.size() > 1) {
       cv::polylines(area, pts, false, colour(k), 1, cv::LINE_AA);
     }

@@ -338,6 +338,7 @@ std::vector<Plan> make_plans(const CalibrateOptions& o, const io::Session& s,
         h.refine.translation_sigma_m, h.max_sigma_m, h.estimate_offset, fixed,
         static_cast<int>(h.duplicates), h.pairs.max_gap_s, h.refine.huber, h.refine.estimate_scale,
         h.odometry_preset.empty() ? "rig" : h.odometry_preset, h.odometry_sweep_motion);
+    if (h.fit_at_rig) p.options += " fit_at_rig";
     p.run = [odometry, scans, gnss, h](const rig::Rig& rig, const report::Progress& pr) {
       hand_eye::StepInputs in;
       in.lidar = odometry;

@@ -139,7 +139,11 @@ std::vector<ResidualLevel> residual_levels(const rig::Rig& stored,
       {"lidar_camera", "boards' noise scale (1: as their covariances say)", "",
        "noise_scale_at_rig", "noise_scale", 1},
       {"lidar_camera", "board normal angle RMS", "deg", "normal_angle_rms_at_rig_deg", "", 1},
-      {"lidar_camera", "board distance RMS", "mm", "distance_rms_at_rig_m", "", 1e3}};
+      {"lidar_camera", "board distance RMS", "mm", "distance_rms_at_rig_m", "", 1e3},
+      {"hand_eye", "motion pairs' median rotation residual", "deg",
+       "pair_rotation_median_at_rig_deg", "pair_rotation_median_deg", 1},
+      {"hand_eye", "motion pairs' median translation residual", "mm",
+       "pair_translation_median_at_rig_m", "pair_translation_median_m", 1e3}};
   std::vector<ResidualLevel> out;
   for (const Row& row : kRows) {
     const auto run = std::find_if(estimate.steps.begin(), estimate.steps.end(),
@@ -190,7 +194,7 @@ CheckResult check(const rig::Rig& stored, const std::filesystem::path& stored_fi
   CalibrateOptions run = options.calibrate;
   run.rig = stored_file;
   // The new data at the stored parameters too, beside their re-estimate.
-  run.cameras.fit_at_rig = run.lidar_camera.fit_at_rig = true;
+  run.cameras.fit_at_rig = run.lidar_camera.fit_at_rig = run.hand_eye.fit_at_rig = true;
   out.estimate = calibrate(run, progress);
 
   // The re-estimate with its own steps' sigmas (those that ended ok) in place of the stored ones.

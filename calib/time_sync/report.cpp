@@ -128,6 +128,13 @@ std::vector<io::OutputFile> time_sync_report_files(
       coarse = near;
     }
     p.series = {coarse, fine};
+    if (r.verdict == "ok") {
+      // The chosen peak marked, labelled with the offset it gives.
+      report::PlotSeries peak{fmt::format("peak {:+.2f} ms", 1e3 * r.offset_s), {}, {}, {}};
+      peak.x = {r.offset_s}, peak.y = {r.peak_ncc};
+      peak.points = true;
+      p.series.push_back(peak);
+    }
     files.push_back({dir / "correlation.png", report::render_png(p)});
   }
   if (r.verdict == "ok") {

@@ -37,6 +37,15 @@ TEST(CheckSim, AnUnchangedRigIsConsistentAndATurnedCameraIsFlaggedOnItself) {
   EXPECT_LT(same_rms["at_stored"].get<double>(), 1.5 * same_rms["reestimated"].get<double>());
   EXPECT_GT(same_rms["stored"].get<double>(), 0.0);
   EXPECT_LT(same_boards["at_stored"].get<double>(), 2.0);
+  // The new motion at the stored T_gnss_lidar and clock: as close as the re-estimate's.
+  const nlohmann::json same_motion = level(same, "motion pairs' median rotation");
+  ASSERT_TRUE(same_motion.is_object());
+  EXPECT_LT(same_motion["at_stored"].get<double>(), 1.5 * same_motion["reestimated"].get<double>());
+  std::printf(
+      "[ figures ] unchanged, the new motion pairs' median rotation residual %.4f deg at the "
+      "stored calibration, %.4f re-estimated (the calibration's own %.4f)\n",
+      same_motion["at_stored"].get<double>(), same_motion["reestimated"].get<double>(),
+      same_motion["stored"].is_number() ? same_motion["stored"].get<double>() : NAN);
 
   ASSERT_EQ(changes[1].sensor, "cam_r");
   const testing::CheckOutcome turned = testing::simulated_check(dir, 1, changes[1], config);
