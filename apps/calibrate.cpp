@@ -3,13 +3,10 @@
 #include "rigcal/session/calibrate.h"
 
 #include <fmt/format.h>
-#include <fmt/ranges.h>
 
-#include <cmath>
 #include <memory>
 
 #include "cli.h"
-#include "rigcal/core/text.h"
 #include "rigcal/lidar/odometry.h"
 #include "step_output.h"
 
@@ -23,26 +20,6 @@ struct Options {
   bool no_estimate_offset = false, no_sweep_motion = false;
 };
 
-// The summary table: one row a step, then each step's reason where it did not end ok.
-void print_table(const session::CalibrateResult& r) {
-  fmt::print("\n  {:<13} {:<13} {:>8}  {}\n", "step", "status", "time", "result");
-  for (const session::StepRun& s : r.steps) {
-    std::string result;
-    for (const report::Figure& f : s.residuals) {
-      if (result.size() > 60) break;
-      const bool whole = f.value == std::floor(f.value) && std::abs(f.value) < 1e9;
-      result += fmt::format("{}{} {}{}", result.empty() ? "" : ", ", f.name,
-                            whole ? fmt::format("{:.0f}", f.value) : fmt::format("{:.4g}", f.value),
-                            f.unit.empty() || f.name.ends_with(f.unit) ? "" : " " + f.unit);
-    }
-    fmt::print("  {:<13} {:<13} {:>8}  {}\n", s.step, s.status,
-               s.cached        ? "cached"
-               : s.seconds > 0 ? fmt::format("{:.2f} s", s.seconds)
-                               : "-",
-               s.status == "ok" ? result : printable(s.reason, 2000));
-  }
-}
-
 void run(Options o) {
   o.run.rig = o.rig, o.run.target = o.target, o.run.odometry = o.odometry, o.run.gnss = o.gnss;
   o.run.out = o.out;
@@ -53,49 +30,9 @@ void run(Options o) {
   for (const auto& p : hand_eye::parse_translation_constraints(o.prior, true))
     o.run.hand_eye.refine.fixed.push_back(p);
   const session::CalibrateResult r = session::calibrate(o.run, console_progress());
-  for (const session::StepRun& s : r.steps) {
-    if (s.status == "not run") continue;
-    fmt::print("== {}: {}{}\n", s.step, s.status, s.cached ? " (cached: inputs unchanged)" : "");
-    for (const std::string& line : s.summary) fmt::print("{}\n", line);
-    for (const std::string& n : s.notes) fmt::print("note: {}\n", n);
-    for (const std::string& w : s.warnings) fmt::print("warning: {}\n", w);
-    if (s.status != "ok") fmt::print("{}: {}\n", s.status, printable(s.reason, 2000));
-    if (!s.remedy.empty()) fmt::print("what would settle it: {}\n", s.remedy);
-  }
-  print_table(r);
-  if (r.published) {
-    fmt::print(
-        "\npublished {} (rigcal rig show prints its provenance); the report to read: "
-        "{}/report.html\n",
-        r.calibration.string(), o.out);
-    return;
-  }
-  fmt::print("\nthe report to read: {}/report.html\n", o.out);
-  if (!r.removed_stale.empty())
-    fmt::print("removed {}: an earlier run's, it does not match these inputs\n",
-               r.removed_stale.string());
-  // One line on stderr, last: the first step that failed (else was undetermined) and its reason.
-  std::vector<const session::StepRun*> open;
-  for (const bool failed : {true, false}) {
-    for (const session::StepRun& s : r.steps) {
-      if (s.status != "ok" && s.status != "not run" && (s.status == "failed") == failed)
-        open.push_back(&s);
-    }
-  }
-  if (open.empty()) {
-    std::vector<std::string> not_run;
-    for (const session::StepRun& s : r.steps)
-      if (s.status == "not run") not_run.push_back(s.step);
-    fmt::print("nothing published: {} not run\n", fmt::join(not_run, ", "));
-  } else {
-    const session::StepRun& first = *open.front();
-    std::string others;
-    for (size_t k = 1; k < open.size(); ++k)
-      others += fmt::format("{}{} {}", k == 1 ? "; also " : ", ", open[k]->step, open[k]->status);
-    fmt::print(stderr, "rigcal: {}: {}: {} (nothing published{})\n",
-               first.status == "failed" ? "error" : first.status, first.step,
-               printable(first.reason, 2000), others);
-  }
+  const session::CalibrateText text = session::calibrate_text(r, o.out);
+  for (const std::string& line : text.lines) fmt::print("{}\n", line);
+  if (!text.error_line.empty()) fmt::print(stderr, "{}\n", text.error_line);
   if (r.exit_status != 0) throw Exit{r.exit_status};
 }
 

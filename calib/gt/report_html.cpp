@@ -17,11 +17,6 @@ using nlohmann::json;
 using report::html_escape;
 using report::html_number;
 
-std::string svg_figure(const report::Plot& plot, const std::string& caption) {
-  return fmt::format("<figure>{}<figcaption>{}</figcaption></figure>\n",
-                     report::html_inline_svg(report::render_svg(plot)), caption);
-}
-
 // The RMS of a {rms, median, max} statistic in mm ("-" when there is none: null).
 std::string rms(const json& s) {
   return s.is_object() ? html_number(s["rms"], "{:.1f}", 1e3) : "-";
@@ -68,9 +63,10 @@ std::string priors_section(const json& r) {
                       "",
                       {h, v}};
     if (!rejected.x.empty()) plot.series.push_back(rejected);
-    out += svg_figure(plot,
-                      "Each prior's residual along the recording, horizontal and vertical; the "
-                      "rejected ones in their own colour.");
+    out += report::html_plot_figure(
+        plot,
+        "Each prior's residual along the recording, horizontal and vertical; the "
+        "rejected ones in their own colour.");
   }
   if (rows.empty()) {
     out += "<p>No prior was rejected.</p>\n";
@@ -106,13 +102,14 @@ std::string bundle_section(const json& b) {
   }
   if (k > 0) {
     before.points = after.points = true;
-    out += svg_figure(report::Plot{"Points off their planes, each window",
-                                   "window",
-                                   "point-to-plane RMS [mm]",
-                                   "",
-                                   {before, after}},
-                      "Each window's point-to-plane RMS before and after its adjustment: a "
-                      "window that does not come down is one whose scans did not agree.");
+    out += report::html_plot_figure(
+        report::Plot{"Points off their planes, each window",
+                     "window",
+                     "point-to-plane RMS [mm]",
+                     "",
+                     {before, after}},
+        "Each window's point-to-plane RMS before and after its adjustment: a "
+        "window that does not come down is one whose scans did not agree.");
   }
   return out;
 }
@@ -246,11 +243,10 @@ std::string ground_truth_html(const json& r, const std::string& top_view_svg) {
   body +=
       "<h2 id=\"summary\">The trajectory</h2>\n" + report::html_table({"quantity", "value"}, rows);
   if (!top_view_svg.empty()) {
-    body += fmt::format(
-        "<figure>{}<figcaption>The ground truth's LiDAR positions in the local ENU frame, "
-        "coloured by their horizontal 1-sigma: where it grows, the GNSS was out or "
-        "rejected.</figcaption></figure>\n",
-        report::html_inline_svg(top_view_svg));
+    body += report::html_figure(
+        report::html_inline_svg(top_view_svg),
+        "The ground truth's LiDAR positions in the local ENU frame, coloured by their horizontal "
+        "1-sigma: where it grows, the GNSS was out or rejected.");
   }
   if (r.contains("markers")) body += markers_section(r["markers"]);
   body += priors_section(r);

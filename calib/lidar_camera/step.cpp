@@ -11,7 +11,6 @@
 #include "rigcal/io/point_cloud_io.h"
 #include "rigcal/io/target_yaml.h"
 #include "rigcal/lidar_camera/report.h"
-#include "rigcal/report/json.h"
 #include "rigcal/report/rotation.h"
 
 namespace rigcal::lidar_camera {
@@ -139,7 +138,9 @@ report::StepResult calibrate_lidar_camera(const StepInputs& in, const StepOption
       s.observability.singular_values[2], s.observability.condition, s.noise_scale));
   out.notes = in.notes;
   out.warnings = outlier_warnings(s);
-  std::optional<Solution> at_rig;  // the boards at the given rig's extrinsic, when asked
+  // The boards at the given rig's extrinsic, when asked: their whitened level and RMS.
+  nlohmann::json at_rig;
+  double noise_scale_at = 0, angle_rms_deg = 0, distance_rms_m = 0;
   const std::optional<SE3> fit_at = o.fit_at ? o.fit_at : prior;
   if (o.fit_at_rig && fit_at) {
     std::vector<BoardPair> used;
@@ -147,13 +148,25 @@ report::StepResult calibrate_lidar_camera(const StepInputs& in, const StepOption
       if (c.pairs[k].used)
         used.push_back({pairs[k].camera->plane, c.pairs[k].lidar.plane, c.pairs[k].lidar.points});
     }
-    Solution a;
-    a.T_camera_lidar = *fit_at;
-    a.residuals = residuals_at(used, *fit_at);
-    double ss = 0;
-    for (const PairResidual& r : a.residuals) ss += r.chi2;
-    a.noise_scale = std::sqrt(ss / std::max<double>(1, 3.0 * a.residuals.size()));
-    at_rig = a;
+    const std::vector<PairResidual> residuals = residuals_at(used, *fit_at);
+    const double n = std::max<double>(1, residuals.size());
+    nlohmann::json chi2 = nlohmann::json::array();
+    for (const PairResidual& r : residuals) {
+      noise_scale_at += r.chi2 / (3 * n);
+      angle_rms_deg += r.normal_angle_deg * r.normal_angle_deg / n;
+      distance_rms_m += r.distance_m * r.distance_m / n;
+      chi2.push_back(r.chi2);
+    }
+    noise_scale_at = std::sqrt(noise_scale_at);
+    angle_rms_deg = std::sqrt(angle_rms_deg), distance_rms_m = std::sqrt(distance_rms_m);
+    at_rig["at_rig"] = {
+        {"definition",
+         "the boards of the pairs used, at the given rig's extrinsic (not re-estimated): "
+         "noise_scale = sqrt(sum chi2 / (3 pairs)), 1 when they fit as their covariances say"},
+        {"noise_scale", noise_scale_at},
+        {"normal_angle_rms_deg", angle_rms_deg},
+        {"distance_rms_m", distance_rms_m},
+        {"pair_chi2", chi2}};
   } else if (o.fit_at_rig) {
     out.notes.push_back(fmt::format("the rig places no {} against {}: nothing to fit the boards to",
                                     o.camera, o.lidar));
@@ -167,30 +180,7 @@ report::StepResult calibrate_lidar_camera(const StepInputs& in, const StepOption
                         search.board_width_m,
                         search.board_height_m};
   out.report_files = lidar_camera_report_files("", rin, pairs, c, cam, shown);
-  double angle_rms_deg = 0, distance_rms_m = 0;
-  if (at_rig) {
-    for (const PairResidual& r : at_rig->residuals) {
-      angle_rms_deg += r.normal_angle_deg * r.normal_angle_deg / at_rig->residuals.size();
-      distance_rms_m += r.distance_m * r.distance_m / at_rig->residuals.size();
-    }
-    angle_rms_deg = std::sqrt(angle_rms_deg), distance_rms_m = std::sqrt(distance_rms_m);
-    for (io::OutputFile& f : out.report_files) {
-      if (f.path != "lidar_camera.json") continue;
-      nlohmann::json j = nlohmann::json::parse(f.content);
-      nlohmann::json chi2 = nlohmann::json::array();
-      for (const PairResidual& r : at_rig->residuals) chi2.push_back(r.chi2);
-      j["at_rig"] = {
-          {"definition",
-           "the boards of the pairs used, at the given rig's extrinsic (not re-estimated): "
-           "noise_scale = sqrt(sum chi2 / (3 pairs)), 1 when they fit as their covariances say"},
-          {"noise_scale", at_rig->noise_scale},
-          {"normal_angle_rms_deg", angle_rms_deg},
-          {"distance_rms_m", distance_rms_m},
-          {"pair_chi2", chi2}};
-      f.content = report::json_text(j);
-    }
-  }
-  report::finish_report(out, "lidar_camera.json");
+  report::finish_report(out, "lidar_camera.json", at_rig);
 
   // The camera placed from the LiDAR: T_b(camera) = T_b(lidar) T_camera_lidar^-1; every other
   // camera keeps its pose relative to this one (the stereo extrinsic).
@@ -212,8 +202,8 @@ report::StepResult calibrate_lidar_camera(const StepInputs& in, const StepOption
                    {"pairs", static_cast<double>(c.pairs.size()), ""},
                    {"noise_scale", s.noise_scale, ""},
                    {"condition", s.observability.condition, ""}};
-  if (at_rig) {
-    out.residuals.push_back({"noise_scale_at_rig", at_rig->noise_scale, ""});
+  if (!at_rig.is_null()) {
+    out.residuals.push_back({"noise_scale_at_rig", noise_scale_at, ""});
     out.residuals.push_back({"normal_angle_rms_at_rig_deg", angle_rms_deg, "deg"});
     out.residuals.push_back({"distance_rms_at_rig_m", distance_rms_m, "m"});
   }

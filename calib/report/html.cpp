@@ -112,6 +112,14 @@ std::string html_inline_svg(std::string_view svg) {
   return out;
 }
 
+std::string html_figure(std::string_view content, std::string_view caption) {
+  return fmt::format("<figure>{}<figcaption>{}</figcaption></figure>\n", content, caption);
+}
+
+std::string html_plot_figure(const Plot& plot, std::string_view caption) {
+  return html_figure(html_inline_svg(render_svg(plot)), caption);
+}
+
 std::string html_inline_image(std::string_view bytes, std::string_view alt, int max_width) {
   const cv::Mat raw(1, static_cast<int>(bytes.size()), CV_8U,
                     const_cast<char*>(bytes.data()));  // read only

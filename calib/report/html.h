@@ -7,6 +7,8 @@
 #include <string_view>
 #include <vector>
 
+#include "rigcal/report/svg_plot.h"
+
 namespace rigcal::report {
 
 // A JSON number as text by `format` (fmt's), times `scale`; "-" where it is not a number (null
@@ -37,5 +39,10 @@ std::string html_inline_svg(std::string_view svg);
 // so that a page with a dozen camera images stays a few MB. Throws rigcal::Error when the bytes
 // are no image.
 std::string html_inline_image(std::string_view bytes, std::string_view alt, int max_width = 1000);
+
+// <figure>: its content and its caption (both HTML already), then a newline.
+std::string html_figure(std::string_view content, std::string_view caption);
+// A plot (svg_plot.h) as an inline SVG figure with its caption (HTML).
+std::string html_plot_figure(const Plot& plot, std::string_view caption);
 
 }  // namespace rigcal::report

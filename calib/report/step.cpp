@@ -12,12 +12,13 @@ std::string_view to_string(StepStatus status) {
   return status == StepStatus::ok ? "ok" : "undetermined";
 }
 
-void finish_report(StepResult& r, std::string_view json_file) {
+void finish_report(StepResult& r, std::string_view json_file, const nlohmann::json& extra) {
   for (io::OutputFile& f : r.report_files) {
     if (f.path != json_file) continue;
     r.report = nlohmann::json::parse(f.content);
     r.report["status"] = to_string(r.status);
     r.report["warnings"] = r.warnings;
+    if (extra.is_object()) r.report.update(extra);
     if (r.status != StepStatus::ok) {
       r.report["reason"] = r.reason;
       r.report["remedy"] = r.remedy;

@@ -59,7 +59,9 @@ struct StepResult {
 // Sets result.report from its JSON file among report_files (`json_file`), with the status, the
 // warnings (and the reason and remedy when undetermined) added, and writes it back. Throws when it
 // is absent.
-void finish_report(StepResult& result, std::string_view json_file);
+// `extra`: keys added to the report as they are (an object, or null for none).
+void finish_report(StepResult& result, std::string_view json_file,
+                   const nlohmann::json& extra = nullptr);
 
 // The report's files under `dir`: <step>.json (the report with the status added) and the figures.
 std::vector<io::OutputFile> report_files_in(const StepResult& result,

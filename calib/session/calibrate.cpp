@@ -4,11 +4,13 @@
 #include <fmt/ranges.h>
 
 #include <chrono>
+#include <cmath>
 #include <map>
 #include <memory>
 
 #include "rigcal/core/error.h"
 #include "rigcal/core/sha256.h"
+#include "rigcal/core/text.h"
 #include "rigcal/core/version.h"
 #include "rigcal/io/files.h"
 #include "rigcal/io/image_sets.h"
@@ -558,6 +560,74 @@ CalibrateResult calibrate(const CalibrateOptions& o, const Progress& progress) {
   const io::OutputFile page = render_report(o.out);
   io::write_file_atomic(page.path, page.content);
   return result;
+}
+
+CalibrateText calibrate_text(const CalibrateResult& r, const fs::path& out) {
+  CalibrateText t;
+  std::vector<std::string>& lines = t.lines;
+  for (const StepRun& s : r.steps) {
+    if (s.status == "not run") continue;
+    lines.push_back(fmt::format("== {}: {}{}", s.step, s.status,
+                                s.cached ? " (cached: inputs unchanged)" : ""));
+    for (const std::string& line : s.summary) lines.push_back(line);
+    for (const std::string& n : s.notes) lines.push_back("note: " + n);
+    for (const std::string& w : s.warnings) lines.push_back("warning: " + w);
+    if (s.status != "ok")
+      lines.push_back(fmt::format("{}: {}", s.status, printable(s.reason, 2000)));
+    if (!s.remedy.empty()) lines.push_back("what would settle it: " + s.remedy);
+  }
+  // The table: one row a step, its residual figures or the reason it did not end ok.
+  lines.push_back("");
+  lines.push_back(fmt::format("  {:<13} {:<13} {:>8}  {}", "step", "status", "time", "result"));
+  for (const StepRun& s : r.steps) {
+    std::string result;
+    for (const report::Figure& f : s.residuals) {
+      if (result.size() > 60) break;
+      const bool whole = f.value == std::floor(f.value) && std::abs(f.value) < 1e9;
+      result += fmt::format("{}{} {}{}", result.empty() ? "" : ", ", f.name,
+                            whole ? fmt::format("{:.0f}", f.value) : fmt::format("{:.4g}", f.value),
+                            f.unit.empty() || f.name.ends_with(f.unit) ? "" : " " + f.unit);
+    }
+    lines.push_back(fmt::format("  {:<13} {:<13} {:>8}  {}", s.step, s.status,
+                                s.cached        ? "cached"
+                                : s.seconds > 0 ? fmt::format("{:.2f} s", s.seconds)
+                                                : "-",
+                                s.status == "ok" ? result : printable(s.reason, 2000)));
+  }
+  lines.push_back("");
+  if (r.published) {
+    lines.push_back(fmt::format(
+        "published {} (rigcal rig show prints its provenance); the report to read: {}/report.html",
+        r.calibration.string(), out.string()));
+    return t;
+  }
+  lines.push_back(fmt::format("the report to read: {}/report.html", out.string()));
+  if (!r.removed_stale.empty()) {
+    lines.push_back(fmt::format("removed {}: an earlier run's, it does not match these inputs",
+                                r.removed_stale.string()));
+  }
+  std::vector<const StepRun*> open;  // failed first, then undetermined or blocked
+  for (const bool failed : {true, false}) {
+    for (const StepRun& s : r.steps) {
+      if (s.status != "ok" && s.status != "not run" && (s.status == "failed") == failed)
+        open.push_back(&s);
+    }
+  }
+  if (open.empty()) {
+    std::vector<std::string> not_run;
+    for (const StepRun& s : r.steps)
+      if (s.status == "not run") not_run.push_back(s.step);
+    lines.push_back(fmt::format("nothing published: {} not run", fmt::join(not_run, ", ")));
+    return t;
+  }
+  const StepRun& first = *open.front();
+  std::string others;
+  for (size_t k = 1; k < open.size(); ++k)
+    others += fmt::format("{}{} {}", k == 1 ? "; also " : ", ", open[k]->step, open[k]->status);
+  t.error_line = fmt::format("rigcal: {}: {}: {} (nothing published{})",
+                             first.status == "failed" ? "error" : first.status, first.step,
+                             printable(first.reason, 2000), others);
+  return t;
 }
 
 }  // namespace rigcal::session

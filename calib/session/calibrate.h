@@ -79,4 +79,14 @@ using Progress = report::Progress;
 // without the earlier steps' cached results); a step's own bad input is a failed StepRun.
 CalibrateResult calibrate(const CalibrateOptions& options, const Progress& progress = {});
 
+// What a run says to people: `lines` for stdout (each step that ran: its summary, notes,
+// warnings, reason and remedy; the table of steps; what was published or removed; the page to
+// read; "" a blank line) and `error_line` for stderr, last: the first step that failed (else was
+// undetermined) with its reason, "" when none did.
+struct CalibrateText {
+  std::vector<std::string> lines;
+  std::string error_line;
+};
+CalibrateText calibrate_text(const CalibrateResult& result, const std::filesystem::path& out);
+
 }  // namespace rigcal::session

@@ -45,19 +45,11 @@ std::string rotation_cell(const json& axis_angle, const json& sigma_deg, std::st
       html_number(sigma_deg[2], "{:.4f}"));
 }
 
-std::string figure(const std::string& inner, const std::string& caption) {
-  return fmt::format("<figure>{}<figcaption>{}</figcaption></figure>\n", inner, caption);
-}
-
 // A PNG of the step's folder inline, when it is there.
 std::string png_figure(const fs::path& file, const std::string& caption) {
   if (!fs::exists(file)) return "";
-  return figure(report::html_inline_image(io::read_text_file(file), file.filename().string()),
-                caption);
-}
-
-std::string svg_figure(const report::Plot& plot, const std::string& caption) {
-  return figure(report::html_inline_svg(report::render_svg(plot)), caption);
+  return report::html_figure(
+      report::html_inline_image(io::read_text_file(file), file.filename().string()), caption);
 }
 
 std::string list(const json& lines, const char* cls) {
@@ -137,7 +129,7 @@ std::string camera_figures(const std::string& name, const json& cam,
                     true,
                     {0, w, 0, h}};
   if (!outliers.x.empty()) over.series.push_back(outliers);
-  out += svg_figure(
+  out += report::html_plot_figure(
       over, fmt::format("Every detected corner where it lies in {}'s image ({:g} x {:g} px), "
                         "coloured by its residual (projected less observed). Parts of the image "
                         "without corners are where the lens model is extrapolated.",
@@ -156,11 +148,11 @@ std::string camera_figures(const std::string& name, const json& cam,
                        {vectors, circle},
                        true};
   if (!far.x.empty()) scatter.series.push_back(far);
-  out += svg_figure(scatter,
-                    fmt::format("{}'s residuals (projected less observed), one point a corner, "
-                                "the circle at their RMS: a round cloud centred at zero is noise; "
-                                "a shape or an offset is a model error.",
-                                html_escape(name)));
+  out += report::html_plot_figure(
+      scatter, fmt::format("{}'s residuals (projected less observed), one point a corner, "
+                           "the circle at their RMS: a round cloud centred at zero is noise; "
+                           "a shape or an offset is a model error.",
+                           html_escape(name)));
   // The histogram of |residual| against the Rayleigh density the RMS implies for isotropic
   // Gaussian noise.
   const double top = *std::max_element(norms.begin(), norms.end());
@@ -183,10 +175,11 @@ std::string camera_figures(const std::string& name, const json& cam,
                          "",
                          {hist, model}};
   histogram.step = true;
-  out += svg_figure(histogram,
-                    "Counts of |residual| in 30 bins, and the Rayleigh curve that isotropic "
-                    "Gaussian noise of the same RMS gives: a heavier tail is outliers the "
-                    "rejection kept or a lens the model does not fit.");
+  out += report::html_plot_figure(
+      histogram,
+      "Counts of |residual| in 30 bins, and the Rayleigh curve that isotropic "
+      "Gaussian noise of the same RMS gives: a heavier tail is outliers the "
+      "rejection kept or a lens the model does not fit.");
   const json& u = cam["projection_uncertainty"];
   if (u.is_object() && u.contains("grid")) {
     const json& g = u["grid"];
@@ -215,7 +208,7 @@ std::string camera_figures(const std::string& name, const json& cam,
     map.series.back().values.clear();
     map.series.back().label = "corners";
     map.series.back().points = true;
-    out += svg_figure(
+    out += report::html_plot_figure(
         map, fmt::format("{}: the 1-sigma of a pixel's projection over the image (mrcal's "
                          "definition: the whole covariance, the boards' poses included, for a "
                          "point at the boards' median distance), contours at 1-2-5 steps, the "
@@ -370,9 +363,10 @@ std::string lidar_camera_section(const json& j, const fs::path& dir) {
                      "",
                      {in_pairs, gate}};
     if (!out_pairs.x.empty()) chi.series.push_back(out_pairs);
-    out += svg_figure(chi,
-                      "How well each board's plane in the camera agrees with its LiDAR points "
-                      "after the extrinsic; above the gate a pair is an outlier and left out.");
+    out += report::html_plot_figure(
+        chi,
+        "How well each board's plane in the camera agrees with its LiDAR points "
+        "after the extrinsic; above the gate a pair is an outlier and left out.");
   }
   out +=
       "<p>The overlays: the scan's points projected into the image with the extrinsic, "
@@ -440,10 +434,11 @@ std::string time_sync_section(const json& j, const fs::path& dir) {
                            "",
                            {used, est}};
       if (!unused.x.empty()) windows.series.push_back(unused);
-      out += svg_figure(windows,
-                        "Each window's offset with its 1-sigma; the line is the offset the step "
-                        "reports (with the drift when significant). Windows that scatter beyond "
-                        "their bars mean the sigmas are too small or the clock jitters.");
+      out += report::html_plot_figure(
+          windows,
+          "Each window's offset with its 1-sigma; the line is the offset the step "
+          "reports (with the drift when significant). Windows that scatter beyond "
+          "their bars mean the sigmas are too small or the clock jitters.");
     }
   }
   if (j["three_axis"].is_object() && j["three_axis"].value("enabled", false)) {
@@ -516,11 +511,12 @@ std::string hand_eye_section(const json& j, const fs::path& dir) {
     report::Plot a{
         "Each motion pair's rotation residual", "pair start [s]", "rotation [deg]", "", {rot}};
     if (!rot_out.x.empty()) a.series.push_back(rot_out);
-    out += svg_figure(a, "|B X - X A|'s rotation for each pair of poses, after the estimate.");
+    out += report::html_plot_figure(
+        a, "|B X - X A|'s rotation for each pair of poses, after the estimate.");
     report::Plot b{
         "Each motion pair's translation residual", "pair start [s]", "translation [mm]", "", {tr}};
     if (!tr_out.x.empty()) b.series.push_back(tr_out);
-    out += svg_figure(b, "The same pairs' translation residual.");
+    out += report::html_plot_figure(b, "The same pairs' translation residual.");
   }
   out += png_figure(dir / "trajectories.png",
                     "The LiDAR odometry and the GNSS/INS trajectory after the extrinsic.");

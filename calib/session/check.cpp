@@ -127,9 +127,8 @@ double figure_value(const std::vector<report::Figure>& figures, const std::strin
 
 // The new data at the stored parameters, from the re-estimate's steps (which fitted them with
 // fit_at_rig), beside the stored calibration's levels and the re-estimate's.
-std::vector<ResidualLevel> residual_levels(const rig::Rig& stored,
+std::vector<ResidualLevel> residual_levels(const std::vector<StepRecord>& records,
                                            const CalibrateResult& estimate) {
-  const std::vector<StepRecord> records = read_steps(stored);
   struct Row {
     const char *step, *what, *unit, *at_stored, *level;
     double scale;
@@ -384,7 +383,7 @@ CheckResult check(const rig::Rig& stored, const std::filesystem::path& stored_fi
   out.suspects.assign(suspects.begin(), suspects.end());
   const int run_status = out.estimate.exit_status;
   out.exit_status = any_changed ? 3 : (run_status == 1 || run_status == 2) ? run_status : 0;
-  out.residual_levels = residual_levels(stored, out.estimate);
+  out.residual_levels = residual_levels(records, out.estimate);
   return out;
 }
 

@@ -99,10 +99,11 @@ std::string diff_html_sections(const nlohmann::json& d, const Figures& figures) 
     const std::string file = fmt::format("projection_diff_{}.svg", name);
     for (const auto& [figure, svg] : figures) {
       if (figure != file) continue;
-      out += fmt::format(
-          "<figure>{}<figcaption>{}: |projection difference| over the image, every {:g} px, "
-          "with the camera's rotation taken out (colour bar in px)</figcaption></figure>\n",
-          report::html_inline_svg(svg), html_escape(name), p["grid_step_px"].get<double>());
+      out += report::html_figure(
+          report::html_inline_svg(svg),
+          fmt::format("{}: |projection difference| over the image, every {:g} px, with the "
+                      "camera's rotation taken out (colour bar in px)",
+                      html_escape(name), p["grid_step_px"].get<double>()));
     }
   }
   for (const char* side : {"only_in_a", "only_in_b"}) {

@@ -167,12 +167,11 @@ report::StepResult estimate_clock(const StepInputs& in, const TimeSyncOptions& t
       "peak: NCC {:.3f}, second peak {:.3f} at {:+.4f} s (ratio {:.2f}); overlap {:.1f} s",
       r.peak_ncc, r.second_peak_ncc, r.second_peak_offset_s, r.peak_ratio, r.overlap_s));
   if (r.three_axis) {
-    const nlohmann::json aa = report::axis_angle_json(r.R_reference_other);
+    const auto [angle_deg, axis] = report::angle_axis_deg(r.R_reference_other);
     out.summary.push_back(fmt::format(
         "rotation other -> reference: {:.3f} deg about [{:.4f} {:.4f} {:.4f}]; residual RMS "
         "{:.4f} rad/s",
-        aa["angle_deg"].get<double>(), aa["axis"][0].get<double>(), aa["axis"][1].get<double>(),
-        aa["axis"][2].get<double>(), r.residual_rms_rad_s));
+        angle_deg, axis.x(), axis.y(), axis.z(), r.residual_rms_rad_s));
   }
   if (r.drift_estimated) {
     out.summary.push_back(fmt::format(
