@@ -56,7 +56,7 @@ void run(const Options& o) {
   in.corners_cache = std::filesystem::path(o.report) / "corners.vnl";
   const report::StepResult r = camera::calibrate_cameras(in, so, console_progress());
   finish_step(r, o.out, o.report);
-  fmt::print("wrote {} and {}/cameras.json, corners.vnl and PNGs\n", o.out, o.report);
+  fmt::print("wrote {}; the page to read: {}/report.html\n", o.out, o.report);
 }
 
 }  // namespace cameras_command
@@ -71,7 +71,8 @@ void add_cameras(CLI::App& app) {
       "(doc/cameras.md). Images pair by the frame number in their file names, or by timestamp\n"
       "with --session. Writes the rig (OUT.yaml) and a report folder: cameras.json (every figure\n"
       "with its definition), corners.vnl (detections, mrcal's format, reused on the next run),\n"
-      "and PNGs per camera: corners, residual vectors x100, coverage, projection uncertainty.");
+      "PNGs per camera: corners, residual vectors x100, coverage, projection uncertainty,\n"
+      "the stereo pair rectified; and report.html, the page to read (doc/report.md).");
   cmd->add_option("--target", o->target, "target YAML (targets/*.yaml; Kalibr's format)")
       ->required();
   cmd->add_option("--camera", o->cameras, "NAME=GLOB, e.g. cam_l='left/*.png' (once per camera)");

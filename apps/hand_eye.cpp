@@ -53,7 +53,7 @@ void run(const Options& o) {
   const report::StepResult r = hand_eye::estimate_extrinsic(in, so, console_progress());
   finish_step(r, o.out, o.report);
   if (!o.out.empty()) fmt::print("{}: T_b written to {}\n", fmt::join(r.wrote, ", "), o.out);
-  if (!o.report.empty()) fmt::print("report: {}/hand_eye.json and PNGs\n", o.report);
+  if (!o.report.empty()) fmt::print("the page to read: {}/report.html\n", o.report);
 }
 
 }  // namespace hand_eye_command
@@ -101,7 +101,7 @@ void add_hand_eye(CLI::App& app) {
   cmd->add_option("--out", o->out, "output calibration YAML (the sensor's T_b)");
   cmd->add_option("--report", o->report,
                   "report folder: hand_eye.json, residuals.png, "
-                  "trajectories.png");
+                  "trajectories.png, report.html (the page to read)");
   cmd->add_option("--fix", o->fix, "hold a translation component (GNSS/INS frame): z=0.35");
   cmd->add_option("--prior", o->prior,
                   "a translation component's prior with its 1-sigma (GNSS/INS frame, m): "

@@ -70,7 +70,7 @@ void run(Options o) {
   finish_step(r, o.out, o.report);
   if (!o.out.empty())
     fmt::print("{}: T_b written to {} (other cameras follow)\n", o.step.camera, o.out);
-  if (!o.report.empty()) fmt::print("report: {}/lidar_camera.json and pair_NN.png\n", o.report);
+  if (!o.report.empty()) fmt::print("the page to read: {}/report.html\n", o.report);
 }
 
 }  // namespace lidar_camera_command
@@ -105,7 +105,8 @@ void add_lidar_camera(CLI::App& app) {
   cmd->add_option("--out", o->out, "output calibration YAML");
   cmd->add_option("--bayer", o->bayer,
                   "raw Bayer images: rggb | bggr | grbg | gbrg (demosaiced to gray)");
-  cmd->add_option("--report", o->report, "report folder: lidar_camera.json, pair_NN.png");
+  cmd->add_option("--report", o->report,
+                  "report folder: lidar_camera.json, pair_NN.png, report.html (the page to read)");
   cmd->add_option("--board-size", o->board_size,
                   "the physical board W,H in m when larger than the target's outline (a backing "
                   "board)");

@@ -26,7 +26,7 @@ void run(const time_sync::ClockRequest& o) {
                                 : "",
                o.out);
   }
-  if (!o.report.empty()) fmt::print("report: {}/time_sync.json and PNGs\n", o.report);
+  if (!o.report.empty()) fmt::print("the page to read: {}/report.html\n", o.report);
 }
 
 }  // namespace time_offset_command
@@ -65,7 +65,8 @@ void add_time_offset(CLI::App& app) {
   cmd->add_option("--rig", o->rig, "the rig to update");
   cmd->add_option("--out", o->out, "output calibration YAML (needs --rig and --sensor)");
   cmd->add_option("--report", o->report,
-                  "report folder: time_sync.json, correlation.png, aligned.png, windows.png");
+                  "report folder: time_sync.json, correlation.png, aligned.png, windows.png, "
+                  "report.html (the page to read)");
   cmd->add_option("--max-offset", o->max_offset,
                   "search |offset| up to this many seconds, or 'all' (every lag with enough "
                   "overlap)")

@@ -1,5 +1,7 @@
 #include "rigcal/hand_eye/report.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
@@ -134,6 +136,32 @@ std::vector<io::OutputFile> hand_eye_report_files(const std::filesystem::path& d
   top.series = {gs, ls};
   files.push_back({dir / "trajectories.png", report::render_png(top)});
   return files;
+}
+
+std::vector<std::string> fit_warnings(const Refined& r) {
+  std::vector<std::string> out;
+  const size_t n = r.outlier.size();
+  const size_t outliers = static_cast<size_t>(std::count(r.outlier.begin(), r.outlier.end(), true));
+  if (n > 0 && 10 * outliers > n) {
+    out.push_back(fmt::format(
+        "{} of the {} motion pairs ({:.0f} %) are outliers (beyond 3 robust sigmas of the fit): "
+        "the trajectories disagree more often than their noise says. Look at the residuals "
+        "along the recording: a stretch of bad odometry or tracking, jumps in the GNSS/INS "
+        "poses, or clocks apart",
+        outliers, n, 100.0 * double(outliers) / double(n)));
+  }
+  const double ds = r.odometry_scale - 1.0;
+  if (r.odometry_scale_sigma > 0 && std::abs(ds) > 3 * r.odometry_scale_sigma &&
+      std::abs(ds) > 0.01) {
+    out.push_back(fmt::format(
+        "the odometry's distances are {:.1f} % {} than the GNSS/INS's (scale {:.4f} +- {:.4f}, "
+        "{:.1f} sigma from 1): the extrinsic was fitted with that scale, but a LiDAR odometry "
+        "should need none; a tracked camera's scale (its target's size) or a degenerate "
+        "stretch of the odometry is the usual cause",
+        100.0 * std::abs(ds), ds > 0 ? "shorter" : "longer", r.odometry_scale,
+        r.odometry_scale_sigma, std::abs(ds) / r.odometry_scale_sigma));
+  }
+  return out;
 }
 
 }  // namespace rigcal::hand_eye

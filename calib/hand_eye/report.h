@@ -26,4 +26,9 @@ std::vector<io::OutputFile> hand_eye_report_files(const std::filesystem::path& d
                                                   const ClosedForm& cf, const Refined& r,
                                                   const Trajectory& lidar, const Trajectory& gnss);
 
+// What a person must look at before trusting an extrinsic that was found: more than a tenth of
+// the motion pairs outliers; the odometry's scale (estimated with the extrinsic) away from 1 by
+// more than 3 sigma and 1 %.
+std::vector<std::string> fit_warnings(const Refined& r);
+
 }  // namespace rigcal::hand_eye

@@ -289,6 +289,7 @@ report::StepResult estimate(const StepInputs& in, const StepOptions& o, const Tr
   const Eigen::Vector3d &sig_r = r.rotation_sigma_deg, &sig_t = r.translation_sigma_m;
   size_t outliers = 0;
   for (bool b : r.outlier) outliers += b;
+  out.warnings = fit_warnings(r);
 
   out.summary.push_back(fmt::format(
       "{} motion pairs of {} s, {} (LiDAR {} poses, GNSS/INS {} poses); {} left out of the "
@@ -341,6 +342,12 @@ report::StepResult estimate(const StepInputs& in, const StepOptions& o, const Tr
     out.sigmas.push_back({fmt::format("{}.t.{}", name, "xyz"[a]), sig_t[a], "m"});
   for (int a = 0; a < 3; ++a)
     out.sigmas.push_back({fmt::format("{}.rotation.{}", name, "xyz"[a]), sig_r[a], "deg"});
+  {
+    std::vector<std::string> names;  // the covariance's order: rotation, then translation
+    for (const char* part : {"rotation", "t"})
+      for (int a = 0; a < 3; ++a) names.push_back(fmt::format("{}.{}.{}", name, part, "xyz"[a]));
+    out.correlations.push_back(report::correlation_of(name, names, r.covariance));
+  }
   if (o.estimate_offset)
     out.sigmas.push_back({o.sensor + ".time_offset", r.time_offset_sigma_s, "s"});
   out.residuals = {{"pairs", static_cast<double>(pairs.size()), ""},

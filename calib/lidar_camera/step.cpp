@@ -214,6 +214,10 @@ report::StepResult calibrate_lidar_camera(const StepInputs& in, const StepOption
     out.sigmas.push_back(
         {fmt::format("{}.rotation.{}", name, "xyz"[a]), s.rotation_sigma_deg[a], "deg"});
   }
+  std::vector<std::string> names;  // the covariance's order: rotation, then translation
+  for (const char* part : {"rotation", "t"})
+    for (int a = 0; a < 3; ++a) names.push_back(fmt::format("{}.{}.{}", name, part, "xyz"[a]));
+  out.correlations.push_back(report::correlation_of(name, names, s.covariance));
   out.inputs.push_back({"target", in.target});
   for (size_t k = 0; k < in.images.size(); ++k) {
     out.inputs.push_back({"images", in.images[k]});

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
 #include <stdexcept>
 
 #include "rigcal/report/json.h"
@@ -10,6 +11,22 @@ namespace rigcal::report {
 
 std::string_view to_string(StepStatus status) {
   return status == StepStatus::ok ? "ok" : "undetermined";
+}
+
+Correlation correlation_of(std::string name, std::vector<std::string> names,
+                           const Eigen::MatrixXd& covariance) {
+  const Eigen::Index n = static_cast<Eigen::Index>(names.size());
+  if (covariance.rows() != n || covariance.cols() != n)
+    throw std::logic_error(fmt::format("{}: a {}x{} covariance for {} names", name,
+                                       covariance.rows(), covariance.cols(), n));
+  Correlation c{std::move(name), std::move(names), {}};
+  for (Eigen::Index i = 0; i < n; ++i) {
+    for (Eigen::Index j = 0; j < n; ++j) {
+      const double v = covariance(i, i) * covariance(j, j);
+      c.rho.push_back(i == j ? 1.0 : v > 0 ? covariance(i, j) / std::sqrt(v) : 0.0);
+    }
+  }
+  return c;
 }
 
 void finish_report(StepResult& r, std::string_view json_file, const nlohmann::json& extra) {

@@ -5,6 +5,7 @@
 // for people, and a status. "The data do not determine this" is said one way: status
 // undetermined, with the reason and the data that would settle it. Bad input is not a status: it
 // raises rigcal::Error naming file, line or key.
+#include <Eigen/Core>
 #include <filesystem>
 #include <functional>
 #include <nlohmann/json.hpp>
@@ -27,6 +28,18 @@ struct Figure {
   double value = 0;
   std::string unit;  // "px", "m", "deg", "s", ""
 };
+
+// The correlations among a group of the step's sigmas (one estimated quantity: a pose's six
+// components, a lens's fx fy cx cy), so that a comparison can use the whole covariance.
+struct Correlation {
+  std::string name;                // the quantity: "T_cam_r_lidar", "cam_l"
+  std::vector<std::string> names;  // the sigmas' names (Figure::name), in the matrix's order
+  std::vector<double> rho;         // row-major, names.size() squared, 1 on the diagonal
+};
+// The correlation matrix of `covariance` (rows and columns in the order of `names`); a component
+// with no variance is uncorrelated.
+Correlation correlation_of(std::string name, std::vector<std::string> names,
+                           const Eigen::MatrixXd& covariance);
 
 // An input file or folder the step read (the session pipeline hashes them for provenance and
 // its cache).
@@ -53,6 +66,7 @@ struct StepResult {
   // without corners): printed as "warning:", first in the report.
   std::vector<std::string> warnings;
   std::vector<Figure> sigmas, residuals;
+  std::vector<Correlation> correlations;
   std::vector<Input> inputs;
 };
 

@@ -92,6 +92,22 @@ std::vector<report::Figure> figures_from(const nlohmann::json& j) {
   return out;
 }
 
+nlohmann::json correlations_json(const std::vector<report::Correlation>& correlations) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const report::Correlation& c : correlations)
+    out.push_back({{"name", c.name}, {"names", c.names}, {"rho", c.rho}});
+  return out;
+}
+
+std::vector<report::Correlation> correlations_from(const nlohmann::json& j) {
+  std::vector<report::Correlation> out;
+  for (const nlohmann::json& c : j) {
+    out.push_back({c.at("name"), c.at("names").get<std::vector<std::string>>(),
+                   c.at("rho").get<std::vector<double>>()});
+  }
+  return out;
+}
+
 // The cached result of a step: what StepRun shows, the rig it wrote and its inputs' hashes.
 struct Cached {
   StepRun run;
@@ -112,6 +128,7 @@ nlohmann::json run_json(const StepRun& run) {
   j["warnings"] = run.warnings;
   j["sigmas"] = figures_json(run.sigmas);
   j["residuals"] = figures_json(run.residuals);
+  j["correlations"] = correlations_json(run.correlations);
   j["seconds"] = run.seconds;
   return j;
 }
@@ -148,6 +165,7 @@ std::optional<Cached> read_cache(const fs::path& file, const std::string& key) {
     c.run.warnings = j.at("warnings").get<std::vector<std::string>>();
     c.run.sigmas = figures_from(j.at("sigmas"));
     c.run.residuals = figures_from(j.at("residuals"));
+    c.run.correlations = correlations_from(j.at("correlations"));
     c.run.cached = true;
     c.wrote = j.at("wrote").get<std::vector<std::string>>();
     c.rig = rig::parse_rig_yaml(j.at("rig").get<std::string>(), file.string());
@@ -490,11 +508,9 @@ CalibrateResult calibrate(const CalibrateOptions& o, const Progress& progress) {
       const auto t0 = std::chrono::steady_clock::now();
       try {
         report::StepResult r = p.run(result.rig, tell);
+        run = step_run(r);
+        run.step = p.step;
         run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        run.status = std::string(report::to_string(r.status));
-        run.reason = r.reason, run.remedy = r.remedy;
-        run.summary = r.summary, run.notes = r.notes, run.warnings = r.warnings;
-        run.sigmas = r.sigmas, run.residuals = r.residuals;
         step_rig = r.rig;
         wrote = r.wrote;
         write_report_folder(report_dir, r.report_files);
@@ -514,8 +530,8 @@ CalibrateResult calibrate(const CalibrateOptions& o, const Progress& progress) {
     }
     if (run.status == "ok") {
       apply(result.rig, step_rig, wrote);
-      records.push_back(
-          {p.step, run.status, version_string(), "", hashed, run.sigmas, run.residuals});
+      records.push_back({p.step, run.status, version_string(), "", hashed, run.sigmas,
+                         run.residuals, run.correlations});
     }
     status_of[p.step] = run.status;
     result.steps.push_back(std::move(run));
@@ -560,6 +576,25 @@ CalibrateResult calibrate(const CalibrateOptions& o, const Progress& progress) {
   const io::OutputFile page = render_report(o.out);
   io::write_file_atomic(page.path, page.content);
   return result;
+}
+
+StepRun step_run(const report::StepResult& r) {
+  StepRun run;
+  run.step = r.step;
+  run.status = std::string(report::to_string(r.status));
+  run.reason = r.reason, run.remedy = r.remedy;
+  run.summary = r.summary, run.notes = r.notes, run.warnings = r.warnings;
+  run.sigmas = r.sigmas, run.residuals = r.residuals, run.correlations = r.correlations;
+  return run;
+}
+
+io::OutputFile step_run_file(const report::StepResult& r, const fs::path& dir, double seconds) {
+  StepRun run = step_run(r);
+  run.seconds = seconds;
+  nlohmann::json j;
+  j["tool_version"] = version_string();
+  j["run"] = run_json(run);
+  return {dir / "run.json", report::json_text(j)};
 }
 
 CalibrateText calibrate_text(const CalibrateResult& r, const fs::path& out) {

@@ -58,7 +58,16 @@ struct StepRun {
   std::string reason, remedy;
   std::vector<std::string> summary, notes, warnings;
   std::vector<report::Figure> sigmas, residuals;
+  std::vector<report::Correlation> correlations;
 };
+
+// What a step's result says, as calibrate records it (no time, not cached).
+StepRun step_run(const report::StepResult& r);
+// A single step's command with a report folder (`rigcal cameras --report DIR`): DIR/run.json,
+// the step's run as OUT/reports/calibrate.json holds each step's, from which `render_report`
+// (report_html.h) renders DIR/report.html.
+io::OutputFile step_run_file(const report::StepResult& r, const std::filesystem::path& dir,
+                             double seconds);
 
 struct CalibrateResult {
   std::vector<StepRun> steps;

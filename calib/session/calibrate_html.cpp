@@ -282,6 +282,27 @@ std::string cameras_section(const json& j, const fs::path& dir) {
         with_sigmas(T["translation_m"], T["translation_stddev_m"], "{:.2f}", 1e3),
         rotation_cell(T.value("axis_angle", json()), T["rotation_stddev_deg"], name));
   }
+  if (j.contains("stereo_rectification") && j["stereo_rectification"].is_object()) {
+    const json& r = j["stereo_rectification"];
+    const double rms = r["row_difference_rms_px"], expected = r["expected_rms_px"];
+    out += fmt::format(
+        "<p><b>Rectified</b> with this estimate, the {} corners both cameras saw lie on the same "
+        "row within {} px RMS (median {} px); the corner noise alone gives about {} px{}.</p>\n",
+        html_number(r["corners"], "{:.0f}"), html_number(r["row_difference_rms_px"], "{:.3f}"),
+        html_number(r["row_difference_median_abs_px"], "{:.3f}"),
+        html_number(r["expected_rms_px"], "{:.3f}"),
+        rms > 2 * expected + 0.1
+            ? ": <b>more than twice that: the stereo extrinsic or a lens does not fit these "
+              "views</b>"
+            : "");
+    out += png_figure(
+        dir / r["figure"].get<std::string>(),
+        fmt::format("The view with the most shared corners ({}), rectified: left "
+                    "image, then right; each green line is an epipolar line, and a "
+                    "corner (red left, blue right) lies on the same line in both "
+                    "halves when the calibration is right.",
+                    fs::path(r["figure_view_left"].get<std::string>()).filename().string()));
+  }
   const std::vector<CornerRow> corners = read_residuals_csv(dir / "residuals.csv");
   for (const json& cam : j["cameras"]) {
     out += fmt::format("<h3>{}</h3>\n", html_escape(cam["name"].get<std::string>()));
@@ -523,7 +544,8 @@ std::string hand_eye_section(const json& j, const fs::path& dir) {
   return out;
 }
 
-std::string step_section(const json& run, const fs::path& out) {
+// A step's section; `dir` holds its report (<step>.json and its figures).
+std::string step_section(const json& run, const fs::path& dir) {
   const std::string step = run["step"];
   const std::string status = run["status"];
   std::string s = fmt::format(
@@ -536,7 +558,6 @@ std::string step_section(const json& run, const fs::path& out) {
       s += "<p>What would settle it: " + html_escape(run["remedy"].get<std::string>()) + "</p>\n";
   }
   s += list(run["warnings"], "warning");
-  const fs::path dir = out / "reports" / step;
   const fs::path file = dir / (step + ".json");
   if (status == "ok" && fs::exists(file)) {
     try {
@@ -619,8 +640,40 @@ std::string calibrate_html(const fs::path& out) {
   body +=
       "<h2 id=\"steps\">The steps</h2>\n" +
       report::html_table({"step", "status", "time", "residuals (or why not)", "warnings"}, rows);
-  for (const json& s : run["steps"]) body += step_section(s, out);
+  for (const json& s : run["steps"])
+    body += step_section(s, out / "reports" / s["step"].get<std::string>());
   return report::html_page("rigcal calibrate", body);
+}
+
+std::string step_html(const fs::path& dir) {
+  const fs::path file = dir / "run.json";
+  json j;
+  try {
+    j = json::parse(io::read_text_file(file));
+    const json& run = j.at("run");
+    const std::string step = run.at("step"), status = run.at("status");
+    const size_t warnings = run.at("warnings").size();
+    std::string body = fmt::format("<h1>One calibration step: {}</h1>\n", html_escape(step));
+    body += fmt::format("<p>Report folder <code>{}</code>, {}.</p>\n",
+                        html_escape(fs::absolute(dir).lexically_normal().string()),
+                        html_escape(j.at("tool_version").get<std::string>()));
+    const std::string headline =
+        status == "ok" ? fmt::format("The step ended ok{}",
+                                     warnings ? fmt::format(", with {} warning{} to read below",
+                                                            warnings, warnings == 1 ? "" : "s")
+                                              : "; nothing to warn about")
+                       : fmt::format("{}: {}", html_escape(status),
+                                     html_escape(run.at("reason").get<std::string>()));
+    body += fmt::format("<p class=\"headline {}\">{}</p>\n",
+                        status != "ok" ? "bad"
+                        : warnings     ? "unsure"
+                                       : "good",
+                        headline);
+    body += step_section(run, dir);
+    return report::html_page("rigcal " + step, body);
+  } catch (const json::exception& e) {
+    throw Error(fmt::format("{}: not a report rigcal wrote: {}", file.string(), e.what()));
+  }
 }
 
 }  // namespace rigcal::session

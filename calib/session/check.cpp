@@ -201,7 +201,8 @@ CheckResult check(const rig::Rig& stored, const std::filesystem::path& stored_fi
   std::vector<StepRecord> new_records;
   for (const StepRun& s : out.estimate.steps) {
     if (s.status != "ok") continue;
-    new_records.push_back({s.step, s.status, version_string(), "", {}, s.sigmas, s.residuals});
+    new_records.push_back(
+        {s.step, s.status, version_string(), "", {}, s.sigmas, s.residuals, s.correlations});
   }
   auto& meta = estimate.extra_metadata;
   std::erase_if(meta, [](const auto& kv) { return kv.first == "steps"; });
@@ -285,7 +286,8 @@ CheckResult check(const rig::Rig& stored, const std::filesystem::path& stored_fi
     const double k = std::sqrt(chi2_quantile(options.alarm_p, sig->dof));
     std::vector<double> rot, trans, ms, ppm, px;
     for (size_t i = 0; i < sig->sigma.size(); ++i) {
-      const double s = k * sig->sigma[i];
+      if (!std::isfinite(sig->conditional_sigma[i])) continue;
+      const double s = k * sig->conditional_sigma[i];
       if (q.kind == Quantity::pose)
         (i < 3 ? rot : trans).push_back(i < 3 ? s * kDegPerRad : 1e3 * s);
       if (q.kind == Quantity::clock) (i == 0 ? ms : ppm).push_back(i == 0 ? 1e3 * s : s);
@@ -312,28 +314,30 @@ CheckResult check(const rig::Rig& stored, const std::filesystem::path& stored_fi
     if (v.sensors.size() == 1) suspects.insert(v.sensors[0]);  // a clock, a camera's lens
     if (v.sensors.size() == 2) candidates.insert(v.sensors.begin(), v.sensors.end());
   }
-  // The judged relations with their combined sigmas (rotation rad, then translation m).
+  // The judged relations with their combined covariances (rotation rad, then translation m).
   struct Judged {
     std::string a, b;
-    std::vector<double> sigma;
+    const Significance* significance;
   };
   std::vector<Judged> judged;
   for (const Verdict& v : out.verdicts) {
     if (v.kind == VerdictKind::cannot_tell || v.sensors.size() != 2) continue;
     for (const PoseDifference& p : out.difference.poses)
       if (p.a == v.sensors[0] && p.b == v.sensors[1] && p.significance)
-        judged.push_back({p.a, p.b, p.significance->sigma});
+        judged.push_back({p.a, p.b, &*p.significance});
   }
-  // Every judged relation of a rig against the re-estimate's, in sigmas.
+  // Every judged relation of a rig against the re-estimate's, whitened by its covariance.
   const auto whitened = [&](const rig::Rig& r) {
     std::vector<double> out_r;
     for (const Judged& j : judged) {
       const SE3 T_p = rig::T_a_b(r, j.a, j.b), T_e = rig::T_a_b(estimate, j.a, j.b);
-      const Eigen::Vector3d rot = rotation_vector(T_e.R * T_p.R.transpose()), t = T_e.t - T_p.t;
-      for (int i = 0; i < 6; ++i) {
-        const double x = i < 3 ? rot[i] : t[i - 3];
-        if (std::isfinite(j.sigma[size_t(i)])) out_r.push_back(x / j.sigma[size_t(i)]);
-      }
+      Eigen::Matrix<double, 6, 1> d;
+      d << rotation_vector(T_e.R * T_p.R.transpose()), T_e.t - T_p.t;
+      const std::vector<size_t>& c = j.significance->components;
+      Eigen::VectorXd dc(static_cast<Eigen::Index>(c.size()));
+      for (size_t i = 0; i < c.size(); ++i) dc[Eigen::Index(i)] = d[Eigen::Index(c[i])];
+      const Eigen::VectorXd w = j.significance->whiten * dc;
+      out_r.insert(out_r.end(), w.data(), w.data() + w.size());
     }
     return Eigen::Map<Eigen::VectorXd>(out_r.data(), Eigen::Index(out_r.size())).eval();
   };

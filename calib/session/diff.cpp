@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
@@ -24,36 +25,72 @@ namespace {
 constexpr double kDeg = M_PI / 180.0;
 
 // The significance of `difference` against the sigmas stored under `keys` (each scaled by
-// `to_si` to the difference's units) in A and in B; none when neither stores any of them.
+// `to_si` to the difference's units) in A and in B, with the correlations they stored among
+// them: the chi-square d' (C_A + C_B)^-1 d over the components either gives a sigma of; none
+// when neither stores any of them.
 std::optional<Significance> significance(const std::vector<double>& difference,
                                          const std::vector<std::string>& keys,
                                          const std::vector<double>& to_si,
-                                         const std::map<std::string, double>& sigmas_a,
-                                         const std::map<std::string, double>& sigmas_b) {
+                                         const StoredUncertainty& a, const StoredUncertainty& b) {
   Significance s;
   s.sigma.assign(difference.size(), NAN);
+  s.conditional_sigma.assign(difference.size(), NAN);
   for (size_t i = 0; i < difference.size(); ++i) {
-    double variance = 0;
-    bool any = false;
-    for (const auto* sigmas : {&sigmas_a, &sigmas_b}) {
-      const auto it = sigmas->find(keys[i]);
-      if (it == sigmas->end()) continue;
-      variance += std::pow(it->second * to_si[i], 2);
-      any = true;
-    }
-    if (!any || !(variance > 0)) continue;
-    s.sigma[i] = std::sqrt(variance);
-    s.chi2 += std::pow(difference[i] / s.sigma[i], 2);
-    ++s.dof;
+    if (a.sigma.count(keys[i]) || b.sigma.count(keys[i])) s.components.push_back(i);
   }
-  if (s.dof == 0) return std::nullopt;
+  const Eigen::Index n = static_cast<Eigen::Index>(s.components.size());
+  Eigen::MatrixXd C = Eigen::MatrixXd::Zero(n, n);
+  Eigen::VectorXd d(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const size_t ci = s.components[size_t(i)];
+    d[i] = difference[ci];
+    for (Eigen::Index j = 0; j < n; ++j) {
+      const size_t cj = s.components[size_t(j)];
+      for (const StoredUncertainty* u : {&a, &b}) {
+        const auto si = u->sigma.find(keys[ci]), sj = u->sigma.find(keys[cj]);
+        if (si == u->sigma.end() || sj == u->sigma.end()) continue;
+        const double rho = u->correlation(keys[ci], keys[cj]);
+        if (i != j && rho != 0) s.correlated = true;
+        C(i, j) += rho * si->second * to_si[ci] * sj->second * to_si[cj];
+      }
+    }
+  }
+  // Components with no variance (a sigma of 0 stored) say nothing: left out.
+  std::vector<Eigen::Index> keep;
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (C(i, i) > 0 && std::isfinite(C(i, i))) keep.push_back(i);
+  if (keep.empty()) return std::nullopt;
+  const Eigen::Index m = static_cast<Eigen::Index>(keep.size());
+  Eigen::MatrixXd Ck(m, m);
+  Eigen::VectorXd dk(m);
+  std::vector<size_t> kept;
+  for (Eigen::Index i = 0; i < m; ++i) {
+    dk[i] = d[keep[size_t(i)]];
+    kept.push_back(s.components[size_t(keep[size_t(i)])]);
+    for (Eigen::Index j = 0; j < m; ++j) Ck(i, j) = C(keep[size_t(i)], keep[size_t(j)]);
+  }
+  s.components = kept;
+  // The whitening W (W' W = C^-1) from C's eigen-decomposition; directions with no variance to
+  // speak of (stored correlations of +-1 within rounding) are given a floor of 1e-12 of the
+  // largest.
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Ck);
+  const double floor = 1e-12 * eig.eigenvalues().maxCoeff();
+  const Eigen::VectorXd inv_sqrt = eig.eigenvalues().cwiseMax(floor).cwiseSqrt().cwiseInverse();
+  s.whiten = inv_sqrt.asDiagonal() * eig.eigenvectors().transpose();
+  const Eigen::MatrixXd information = s.whiten.transpose() * s.whiten;
+  for (Eigen::Index i = 0; i < m; ++i) {
+    s.sigma[kept[size_t(i)]] = std::sqrt(Ck(i, i));
+    s.conditional_sigma[kept[size_t(i)]] = 1.0 / std::sqrt(information(i, i));
+  }
+  s.chi2 = (s.whiten * dk).squaredNorm();
+  s.dof = static_cast<int>(m);
   s.p_value = chi2_upper_tail(s.chi2, s.dof);
   return s;
 }
 
 PoseDifference pose_difference(const SE3& T_a_b_in_a, const SE3& T_a_b_in_b, std::string a,
-                               std::string b, const std::map<std::string, double>& sigmas_a,
-                               const std::map<std::string, double>& sigmas_b) {
+                               std::string b, const StoredUncertainty& sigmas_a,
+                               const StoredUncertainty& sigmas_b) {
   PoseDifference d;
   d.a = std::move(a);
   d.b = std::move(b);
@@ -162,9 +199,8 @@ ProjectionDifference projection_difference(const rig::CameraModel& A, const rig:
 }
 
 CameraDifference camera_difference(const rig::Sensor& a, const rig::Sensor& b,
-                                   const DiffConfig& config,
-                                   const std::map<std::string, double>& sigmas_a,
-                                   const std::map<std::string, double>& sigmas_b) {
+                                   const DiffConfig& config, const StoredUncertainty& sigmas_a,
+                                   const StoredUncertainty& sigmas_b) {
   const rig::CameraModel &A = a.camera, &B = b.camera;
   CameraDifference d;
   d.camera = a.name;
@@ -219,7 +255,7 @@ RigDifference diff_rigs(const rig::Rig& a, const rig::Rig& b, const DiffConfig& 
         "the base frames differ ('{}' against '{}'): every pose compared in '{}', the first's",
         a.base_frame, b.base_frame, a.base_frame));
   }
-  const std::map<std::string, double> sigmas_a = stored_sigmas(a), sigmas_b = stored_sigmas(b);
+  const StoredUncertainty sigmas_a = stored_uncertainty(a), sigmas_b = stored_uncertainty(b);
   for (const rig::Sensor& s : a.sensors)
     if (!rig::find_sensor(b, s.name)) out.only_in_a.push_back(s.name);
   for (const rig::Sensor& s : b.sensors)
@@ -264,8 +300,8 @@ RigDifference diff_rigs(const rig::Rig& a, const rig::Rig& b, const DiffConfig& 
       out.cameras.push_back(camera_difference(sa, *sb, config, sigmas_a, sigmas_b));
   }
   // The relations the steps estimated (and stored sigmas of) between two sensors.
-  std::map<std::string, double> all = sigmas_a;
-  all.insert(sigmas_b.begin(), sigmas_b.end());
+  std::map<std::string, double> all = sigmas_a.sigma;
+  all.insert(sigmas_b.sigma.begin(), sigmas_b.sigma.end());
   for (const auto& [first, second] : stored_relations(all, a, b)) {
     if (first == out.base_frame) continue;  // compared above with its sigmas
     out.poses.push_back(pose_difference(rig::T_a_b(a, first, second), rig::T_a_b(b, first, second),
@@ -280,7 +316,11 @@ nlohmann::json significance_json(const std::optional<Significance>& s, double sc
   if (!s) return nullptr;
   nlohmann::json sigma = nlohmann::json::array();
   for (double x : s->sigma) sigma.push_back(std::isfinite(x) ? nlohmann::json(x * scale) : nullptr);
-  return {{"sigma", sigma}, {"chi2", s->chi2}, {"dof", s->dof}, {"p_value", s->p_value}};
+  return {{"sigma", sigma},
+          {"chi2", s->chi2},
+          {"dof", s->dof},
+          {"p_value", s->p_value},
+          {"correlated", s->correlated}};
 }
 
 std::string significance_text(const std::optional<Significance>& s) {
@@ -353,9 +393,11 @@ nlohmann::json diff_json(const RigDifference& d) {
           {"only_in_b", d.only_in_b},
           {"notes", d.notes},
           {"significance_note",
-           "each component against sqrt(sigma_A^2 + sigma_B^2) of the sigmas stored in "
-           "rigcal.steps (their diagonal: correlations ignored; two calibrations from the same "
-           "data are not independent, and p is then too large)"}};
+           "the difference against C_A + C_B, each calibration's covariance from the sigmas and "
+           "the correlations its steps stored in rigcal.steps (sigma: each component's "
+           "sqrt(sigma_A^2 + sigma_B^2); correlated: whether stored correlations entered; "
+           "without them the diagonal alone; two calibrations from the same data are not "
+           "independent, and p is then too large)"}};
 }
 
 std::vector<std::string> diff_lines(const RigDifference& d) {

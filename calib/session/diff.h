@@ -4,7 +4,7 @@
 // projection-diff idea: the rays of A's pixels projected through B). Where a calibration's
 // `rigcal.steps` holds the 1-sigmas of a quantity, its difference is also given in sigmas of the
 // two estimates together, with the chi-square probability of a difference at least that large
-// when nothing changed (the sigmas' correlations are not stored: their diagonal is used).
+// when nothing changed (through the whole covariance where the steps stored the correlations).
 #include <Eigen/Core>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -20,11 +20,19 @@
 namespace rigcal::session {
 
 // A difference's size against its uncertainty: where both or either calibration gives sigmas.
+// The combined covariance is C_A + C_B, each from its stored sigmas and the correlations the
+// step stored among them (none stored: the diagonal).
 struct Significance {
   std::vector<double> sigma;  // combined 1-sigma of each component, sqrt(s_A^2 + s_B^2)
-  double chi2 = 0;            // sum of (difference / sigma)^2 over the components with a sigma
-  int dof = 0;                // those components
-  double p_value = 1;         // P(chi-square(dof) >= chi2): small when the change is real
+  // Each component's 1-sigma with the others known, 1 / sqrt((C^-1)_ii): the size of a change
+  // along that component alone is judged against it (equal to sigma when uncorrelated).
+  std::vector<double> conditional_sigma;
+  double chi2 = 0;                 // d' C^-1 d over the components with a sigma
+  int dof = 0;                     // those components
+  double p_value = 1;              // P(chi-square(dof) >= chi2): small when the change is real
+  bool correlated = false;         // whether stored correlations entered C
+  std::vector<size_t> components;  // the components judged, indexes into the difference
+  Eigen::MatrixXd whiten;          // W with W' W = C^-1 over `components`: chi2 = |W d|^2
 };
 
 // T_a_b in B against A: the rotation Log(R_B R_A') and the translation t_B - t_A, both in frame

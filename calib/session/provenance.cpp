@@ -4,6 +4,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "rigcal/core/error.h"
 #include "rigcal/core/sha256.h"
@@ -73,6 +74,23 @@ std::string steps_yaml(const std::vector<StepRecord>& records) {
       }
       e << YAML::EndMap;
     }
+    if (!r.correlations.empty()) {
+      // Each quantity's correlation matrix, rows in the order of `keys` (the sigmas' keys).
+      e << YAML::Key << "correlations" << YAML::Value << YAML::BeginMap;
+      for (const report::Correlation& c : r.correlations) {
+        e << YAML::Key << c.name << YAML::Value << YAML::BeginMap << YAML::Key << "keys"
+          << YAML::Value << YAML::BeginSeq;
+        for (const std::string& name : c.names) {
+          const auto f = std::find_if(r.sigmas.begin(), r.sigmas.end(),
+                                      [&](const report::Figure& s) { return s.name == name; });
+          e << (f == r.sigmas.end() ? name : figure_key(*f));
+        }
+        e << YAML::EndSeq << YAML::Key << "rho" << YAML::Value << YAML::BeginSeq;
+        for (const double v : c.rho) e << fmt::format("{:.6g}", std::isfinite(v) ? v : 0.0);
+        e << YAML::EndSeq << YAML::EndMap;
+      }
+      e << YAML::EndMap;
+    }
     e << YAML::EndMap;
   }
   e << YAML::EndMap;
@@ -112,11 +130,51 @@ std::vector<StepRecord> read_steps(const rig::Rig& rig) {
             figures->push_back({f->first.as<std::string>(), v, ""});
           }
         }
+        if (const YAML::Node c = n["correlations"]) {
+          for (auto q = c.begin(); q != c.end(); ++q) {
+            report::Correlation k{q->first.as<std::string>(),
+                                  q->second["keys"].as<std::vector<std::string>>(),
+                                  q->second["rho"].as<std::vector<double>>()};
+            if (k.rho.size() != k.names.size() * k.names.size()) {
+              throw Error(fmt::format(
+                  "rigcal.steps: {}: correlations of {}: {} values for {} keys (a square "
+                  "matrix, row by row)",
+                  r.step, k.name, k.rho.size(), k.names.size()));
+            }
+            for (const double v : k.rho) {
+              if (!(std::abs(v) <= 1.0))
+                throw Error(
+                    fmt::format("rigcal.steps: {}: correlations of {}: {} is not in [-1, 1]",
+                                r.step, k.name, v));
+            }
+            r.correlations.push_back(std::move(k));
+          }
+        }
         out.push_back(std::move(r));
       }
     } catch (const YAML::Exception& e) {
       throw Error(
           fmt::format("rigcal.steps: not the provenance rigcal calibrate writes ({})", e.what()));
+    }
+  }
+  return out;
+}
+
+double StoredUncertainty::correlation(const std::string& a, const std::string& b) const {
+  if (a == b) return 1.0;
+  const auto it = rho.find({a, b});
+  return it == rho.end() ? 0.0 : it->second;
+}
+
+StoredUncertainty stored_uncertainty(const rig::Rig& rig) {
+  StoredUncertainty out;
+  for (const StepRecord& s : read_steps(rig)) {
+    for (const report::Figure& f : s.sigmas) out.sigma[f.name] = f.value;
+    for (const report::Correlation& c : s.correlations) {
+      const size_t n = c.names.size();
+      for (size_t i = 0; i < n; ++i)
+        for (size_t j = 0; j < n; ++j)
+          if (i != j) out.rho[{c.names[i], c.names[j]}] = c.rho[i * n + j];
     }
   }
   return out;

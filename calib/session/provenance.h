@@ -27,6 +27,8 @@ struct StepRecord {
   std::string step, status, tool_version, reason;
   std::vector<HashedInput> inputs;
   std::vector<report::Figure> sigmas, residuals;
+  // Read back: names are the stored keys (figure_key of the sigmas they correlate).
+  std::vector<report::Correlation> correlations;
 };
 
 // The records as YAML flow text, for Rig::extra_metadata under the key "steps".
@@ -39,6 +41,15 @@ std::vector<StepRecord> read_steps(const rig::Rig& rig);
 // Every 1-sigma the steps of a calibration stored, by the key it was written under
 // ("T_cam_r_lidar.t.x_m", "cam_l.fx_px", "imu.time_offset_s").
 std::map<std::string, double> stored_sigmas(const rig::Rig& rig);
+
+// The stored sigmas with the correlations among them (those a step stored: within one quantity).
+struct StoredUncertainty {
+  std::map<std::string, double> sigma;                        // by key, as stored_sigmas
+  std::map<std::pair<std::string, std::string>, double> rho;  // by the two keys, both orders
+  // The correlation of two keys: 1 for a key with itself, 0 where none is stored.
+  double correlation(const std::string& a, const std::string& b) const;
+};
+StoredUncertainty stored_uncertainty(const rig::Rig& rig);
 
 // "name_unit" unless the name ends with the unit already: the key a figure is written under.
 std::string figure_key(const report::Figure& figure);

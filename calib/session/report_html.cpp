@@ -233,6 +233,7 @@ io::OutputFile render_report(const std::filesystem::path& dir) {
   std::sort(figures.begin(), figures.end());
   if (fs::exists(dir / "reports" / "calibrate.json"))
     return {dir / "report.html", calibrate_html(dir)};
+  if (fs::exists(dir / "run.json")) return {dir / "report.html", step_html(dir)};
   if (fs::exists(dir / "ground_truth.json")) {
     const fs::path top = dir / "trajectory_top.svg";
     try {
@@ -258,9 +259,9 @@ io::OutputFile render_report(const std::filesystem::path& dir) {
     }
   }
   throw Error(
-      fmt::format("{}: no reports/calibrate.json, ground_truth.json, check.json or diff.json to "
-                  "render (rigcal calibrate writes the first in its --out folder, rigcal "
-                  "ground-truth, check and diff the others with --report)",
+      fmt::format("{}: no reports/calibrate.json, run.json, ground_truth.json, check.json or "
+                  "diff.json to render (rigcal calibrate writes the first in its --out folder; "
+                  "the step commands, ground-truth, check and diff the others with --report)",
                   dir.string()));
 }
 

@@ -26,10 +26,14 @@ std::string check_html(const nlohmann::json& check, const NamedFigures& figures)
 // warnings), each step's OUT/reports/<step>/<step>.json and its figures (PNGs inlined; the
 // cameras' residuals.csv drawn as plots with axes in px).
 std::string calibrate_html(const std::filesystem::path& out);
+// A single step's report folder (`rigcal cameras --report DIR`, and lidar-camera, time-offset,
+// hand-eye): DIR/run.json (calibrate.h's step_run_file) and the step's report beside it; the
+// same section as on the calibrate page, under the step's verdict.
+std::string step_html(const std::filesystem::path& dir);
 
 // DIR/report.html rendered again from what a run stored in DIR: a calibrate output folder
-// (reports/calibrate.json), else ground_truth.json (gt/report_html.h), else check.json, else
-// diff.json. Throws rigcal::Error when DIR holds
+// (reports/calibrate.json), else a single step's (run.json), else ground_truth.json
+// (gt/report_html.h), else check.json, else diff.json. Throws rigcal::Error when DIR holds
 // none, or one rigcal did not write.
 io::OutputFile render_report(const std::filesystem::path& dir);
 

@@ -14,6 +14,7 @@
 #include "fixtures.h"
 #include "rigcal/camera/calibrate.h"
 #include "rigcal/camera/lens.h"
+#include "rigcal/camera/rectify.h"
 #include "rigcal/camera/report.h"
 #include "rigcal/camera/uncertainty.h"
 #include "rigcal/core/error.h"
@@ -89,6 +90,34 @@ TEST(CameraReal, OpenCvStereoSamplesMeetTheBarAndMatchOpenCvOnTheSameCorners) {
       ours.rms_2d_px, opencv_rms, r.rms_2d_px, r.n_outliers);
   RecordProperty("opencv_rms_2d_px", std::to_string(opencv_rms));
   EXPECT_LE(ours.rms_2d_px, 1.01 * opencv_rms);
+}
+
+// Rectified with the true lenses and extrinsic, a point's rows agree in both cameras (to the
+// lens's inversion); with the right camera's extrinsic wrong by a turn of 0.2 deg about its x
+// axis, they differ by about f * 0.2 deg, as a person would read off the figure.
+TEST(StereoRectification, RowsAgreeWithTheTruthAndNotWithATurnedCamera) {
+  const rig::Rig rig = rig::read_rig_file(RIGCAL_SOURCE_DIR "/data/sample_rig.yaml");
+  const rig::CameraModel &left = rig::sensor(rig, "cam_l").camera,
+                         &right = rig::sensor(rig, "cam_r").camera;
+  const SE3 T_r_l = rig::T_a_b(rig, "cam_r", "cam_l");
+  SE3 T_r_l_wrong = T_r_l;
+  T_r_l_wrong.R = rotation_from_vector(Eigen::Vector3d(0.2 * M_PI / 180, 0, 0)) * T_r_l.R;
+  Detection in_l, in_r;
+  for (int i = 0; i < 60; ++i) {
+    // Points 2-6 m ahead, spread over both images.
+    const Eigen::Vector3d p_l(-1.0 + 0.04 * i, -0.6 + 0.02 * (i % 7) * 9, 2.0 + 0.07 * i);
+    const std::optional<Eigen::Vector2d> ql = project(left, p_l), qr = project(right, T_r_l * p_l);
+    if (!ql || !qr) continue;
+    in_l.point_ids.push_back(i), in_l.pixels.push_back(*ql);
+    in_r.point_ids.push_back(i), in_r.pixels.push_back(*qr);
+  }
+  ASSERT_GT(in_l.pixels.size(), 40u);
+  const Rectification truth = rectify(left, right, T_r_l);
+  for (double d : row_differences(truth, left, right, in_l, in_r)) EXPECT_LT(std::abs(d), 1e-6);
+  const Rectification wrong = rectify(left, right, T_r_l_wrong);
+  const std::vector<double> rows = row_differences(wrong, left, right, in_l, in_r);
+  const double expected = wrong.f_px * std::tan(0.2 * M_PI / 180);
+  EXPECT_NEAR(rms(rows), expected, 0.1 * expected);
 }
 
 struct SimCase {

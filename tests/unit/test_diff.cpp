@@ -37,16 +37,16 @@ using rig::testing::sample_rig;
 // The sigmas a calibrate run would store: the stereo extrinsic's, the LiDAR-camera's, cam_r's
 // intrinsics and the IMU's clock.
 void store_sigmas(rig::Rig& rig) {
-  session::StepRecord cameras{"cameras", "ok", "test", "", {}, {}, {}};
+  session::StepRecord cameras{"cameras", "ok", "test", "", {}, {}, {}, {}};
   for (const char* p : {"fx", "fy", "cx", "cy"})
     cameras.sigmas.push_back({fmt::format("cam_r.{}_px", p), 0.5, ""});
-  session::StepRecord lidar_camera{"lidar_camera", "ok", "test", "", {}, {}, {}};
+  session::StepRecord lidar_camera{"lidar_camera", "ok", "test", "", {}, {}, {}, {}};
   for (int i = 0; i < 3; ++i) {
     lidar_camera.sigmas.push_back({fmt::format("T_cam_r_lidar.t.{}_m", "xyz"[i]), 0.001, ""});
     lidar_camera.sigmas.push_back(
         {fmt::format("T_cam_r_lidar.rotation.{}_deg", "xyz"[i]), 0.05, ""});
   }
-  session::StepRecord time_sync{"time_sync", "ok", "test", "", {}, {}, {}};
+  session::StepRecord time_sync{"time_sync", "ok", "test", "", {}, {}, {}, {}};
   time_sync.sigmas.push_back({"imu.time_offset_s", 1e-4, ""});
   rig.extra_metadata.emplace_back("steps", session::steps_yaml({cameras, lidar_camera, time_sync}));
 }
@@ -172,6 +172,58 @@ TEST(Diff, AKnownChangeComesBackAsMadeWithItsSignificance) {
     // is not, and what remains is the scale's share.
     EXPECT_NEAR(p.fitted_rotation_deg, 2.0 / lens.fx / kDeg, 0.3 * 2.0 / lens.fx / kDeg);
     EXPECT_LT(p.fitted_rms_px, 0.6 * p.raw_rms_px);
+  }
+}
+
+// Where the steps stored correlations, the chi-square is d' (C_A + C_B)^-1 d: checked against
+// the 2 x 2 inverse written out, with each calibration's own sigmas and correlation.
+TEST(Diff, StoredCorrelationsEnterTheChiSquare) {
+  const auto with_lens_sigmas = [](double s_fx, double s_cx, double rho) {
+    rig::Rig rig = sample_rig();
+    session::StepRecord cameras{"cameras", "ok", "test", "", {}, {}, {}, {}};
+    cameras.sigmas = {{"cam_r.fx", s_fx, "px"}, {"cam_r.cx", s_cx, "px"}};
+    cameras.correlations.push_back({"cam_r", {"cam_r.fx", "cam_r.cx"}, {1, rho, rho, 1}});
+    rig.extra_metadata.emplace_back("steps", session::steps_yaml({cameras}));
+    return rig;
+  };
+  const rig::Rig a = with_lens_sigmas(0.5, 0.4, 0.8);
+  rig::Rig b = with_lens_sigmas(0.3, 0.6, -0.3);
+  // Read back under the keys the sigmas were stored under, with their units.
+  const session::StoredUncertainty u = session::stored_uncertainty(a);
+  EXPECT_EQ(u.sigma.at("cam_r.fx_px"), 0.5);
+  EXPECT_EQ(u.correlation("cam_r.fx_px", "cam_r.cx_px"), 0.8);
+  EXPECT_EQ(u.correlation("cam_r.cx_px", "cam_r.fx_px"), 0.8);
+  EXPECT_EQ(u.correlation("cam_r.fx_px", "cam_r.fy_px"), 0.0);
+  rig::sensor(b, "cam_r").camera.fx += 1.0;
+  rig::sensor(b, "cam_r").camera.cx += 1.0;
+  const double c11 = 0.25 + 0.09, c22 = 0.16 + 0.36, c12 = 0.8 * 0.5 * 0.4 - 0.3 * 0.3 * 0.6;
+  const double det = c11 * c22 - c12 * c12;
+  const double expected = (c22 - 2 * c12 + c11) / det;  // d = (1, 1)
+  for (const session::CameraDifference& c : session::diff_rigs(a, b).cameras) {
+    if (c.camera != "cam_r") continue;
+    ASSERT_TRUE(c.significance);
+    EXPECT_TRUE(c.significance->correlated);
+    EXPECT_EQ(c.significance->dof, 2);
+    EXPECT_NEAR(c.significance->chi2, expected, 1e-4 * expected);
+    EXPECT_NEAR(c.significance->sigma[0], std::sqrt(c11), 1e-12);
+    // A change along fx alone, with cx known: judged against sqrt(det / c22).
+    EXPECT_NEAR(c.significance->conditional_sigma[0], std::sqrt(det / c22), 1e-6);
+    EXPECT_NEAR(c.significance->conditional_sigma[2], std::sqrt(det / c11), 1e-6);
+    // Without the correlations the same difference weighs otherwise.
+    EXPECT_GT(std::abs(c.significance->chi2 - (1 / c11 + 1 / c22)), 0.05);
+  }
+  // A matrix that is not one is refused, naming what is wrong.
+  rig::Rig bad = sample_rig();
+  bad.extra_metadata.emplace_back(
+      "steps",
+      "{cameras: {status: ok, tool_version: t, inputs: [], sigmas: {cam_r.fx_px: 0.5}, "
+      "residuals: {}, correlations: {cam_r: {keys: [cam_r.fx_px, cam_r.cx_px], rho: [1, 2, 2, "
+      "1]}}}}");
+  try {
+    session::read_steps(bad);
+    ADD_FAILURE() << "a correlation of 2 was read";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("not in [-1, 1]"), std::string::npos) << e.what();
   }
 }
 
@@ -301,7 +353,7 @@ TEST(DiffReport, LoadsInChromiumAndRendersAgainFromItsJson) {
   EXPECT_EQ(testing::slurp(dir / "report/report.html"), page);
   r = testing::rigcal_cli(fmt::format("report {}", dir.string()), dir);
   EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.err.find("no reports/calibrate.json, ground_truth.json, check.json or diff.json"),
+  EXPECT_NE(r.err.find("no reports/calibrate.json, run.json, ground_truth.json, check.json or "),
             std::string::npos)
       << r.err;
   fs::remove_all(dir);

@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <Eigen/Eigenvalues>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -276,6 +277,30 @@ TEST_F(Session, CalibrateNamesTheFailedStepThenRerunsOnlyIt) {
   const rig::Rig truth = rig::read_rig_file(kTruth);
   const std::vector<session::StepRecord> steps = session::read_steps(cal);
   ASSERT_EQ(steps.size(), 4u);
+  // Each estimated pose and lens stored with its correlations: a correlation matrix over keys
+  // the step stored sigmas under (cameras: two lenses and the stereo pose; LiDAR-camera and
+  // hand-eye: their pose).
+  size_t matrices = 0;
+  for (const session::StepRecord& s : steps) {
+    for (const report::Correlation& c : s.correlations) {
+      ++matrices;
+      const size_t n = c.names.size();
+      ASSERT_EQ(c.rho.size(), n * n) << c.name;
+      Eigen::MatrixXd rho(n, n);
+      for (size_t i = 0; i < n; ++i) {
+        const bool stored =
+            std::any_of(s.sigmas.begin(), s.sigmas.end(),
+                        [&](const report::Figure& f) { return f.name == c.names[i]; });
+        EXPECT_TRUE(stored) << c.names[i];
+        for (size_t j = 0; j < n; ++j) rho(i, j) = c.rho[i * n + j];
+      }
+      EXPECT_LT((rho - rho.transpose()).norm(), 1e-12) << c.name;
+      EXPECT_LT((rho.diagonal().array() - 1).abs().maxCoeff(), 1e-12) << c.name;
+      EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(rho).eigenvalues().minCoeff(), -1e-5)
+          << c.name;
+    }
+  }
+  EXPECT_EQ(matrices, 5u);
   auto sigma = [&](const std::string& step, const std::string& key) -> double {
     for (const session::StepRecord& s : steps) {
       for (const report::Figure& f : s.sigmas) {
