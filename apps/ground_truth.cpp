@@ -153,7 +153,8 @@ void add_ground_truth(CLI::App& app) {
                   "the intensity a marker's points reach (default: 10x the first scan's median)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--report", o->report,
-                  "report folder: ground_truth.json, one row a prior, one a window");
+                  "report folder: ground_truth.json (one row a prior, one a window), "
+                  "report.html (the page to read)");
   cmd->callback([o] { run(*o); });
 }
 

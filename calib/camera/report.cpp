@@ -201,12 +201,33 @@ cv::Mat corners_png(const cv::Mat& gray, const Detection& d) {
     const cv::Point p(static_cast<int>(d.pixels[i].x()), static_cast<int>(d.pixels[i].y()));
     cv::circle(out, p, 4, i == 0 ? cv::Scalar(0, 0, 255) : cv::Scalar(0, 200, 0), 1, cv::LINE_AA);
   }
-  if (!d.pixels.empty()) {
-    cv::putText(
-        out, "point 0",
-        cv::Point(static_cast<int>(d.pixels[0].x()) + 6, static_cast<int>(d.pixels[0].y()) - 6),
-        cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 255), 1, cv::LINE_AA);
-  }
+  if (d.pixels.empty()) return out;
+  // The label of point 0 outside the corners (beyond the farthest from their centroid, in point
+  // 0's direction), joined to it by a line: it covers no corner.
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  for (const Eigen::Vector2d& p : d.pixels) centre += p;
+  centre /= static_cast<double>(d.pixels.size());
+  double radius = 0;
+  for (const Eigen::Vector2d& p : d.pixels) radius = std::max(radius, (p - centre).norm());
+  Eigen::Vector2d dir = d.pixels[0] - centre;
+  dir = dir.norm() > 1e-9 ? dir.normalized() : Eigen::Vector2d(-1, -1).normalized();
+  const double scale = std::max(0.5, out.cols / 1400.0);
+  const int thickness = std::max(1, static_cast<int>(std::lround(scale)));
+  int baseline = 0;
+  const cv::Size text =
+      cv::getTextSize("point 0", cv::FONT_HERSHEY_SIMPLEX, scale, thickness, &baseline);
+  const Eigen::Vector2d end = centre + dir * (radius + 12 * scale);
+  // The text's box grows away from the corners: to the left of `end` when pointing left, above
+  // it when pointing up.
+  double x = dir.x() < 0 ? end.x() - text.width : end.x();
+  double y = dir.y() < 0 ? end.y() : end.y() + text.height;
+  x = std::clamp(x, 0.0, std::max(0.0, double(out.cols - text.width)));
+  y = std::clamp(y, double(text.height), double(out.rows - baseline));
+  const cv::Scalar red(0, 0, 255);
+  cv::line(out, cv::Point2d(d.pixels[0].x(), d.pixels[0].y()), cv::Point2d(end.x(), end.y()), red,
+           1, cv::LINE_AA);
+  cv::putText(out, "point 0", cv::Point2d(x, y), cv::FONT_HERSHEY_SIMPLEX, scale, red, thickness,
+              cv::LINE_AA);
   return out;
 }
 

@@ -120,6 +120,30 @@ TEST(StereoRectification, RowsAgreeWithTheTruthAndNotWithATurnedCamera) {
   EXPECT_NEAR(rms(rows), expected, 0.1 * expected);
 }
 
+// The quick look's label of point 0 is drawn outside the corners: no red pixel (the label, its
+// line, point 0's circle) within 6 px of another corner.
+TEST(CameraReport, PointZerosLabelCoversNoCorner) {
+  Detection d;
+  d.found = true;
+  for (int r = 0; r < 6; ++r)
+    for (int c = 0; c < 9; ++c) {
+      d.point_ids.push_back(r * 9 + c);
+      d.pixels.emplace_back(300 + 25 * c + 3 * r, 150 + 24 * r - 2 * c);
+    }
+  const cv::Mat png = corners_png(cv::Mat(480, 640, CV_8UC1, cv::Scalar(128)), d);
+  int red = 0;
+  for (int y = 0; y < png.rows; ++y) {
+    for (int x = 0; x < png.cols; ++x) {
+      const cv::Vec3b bgr = png.at<cv::Vec3b>(y, x);
+      if (!(bgr[2] > 180 && bgr[1] < 90 && bgr[0] < 90)) continue;
+      ++red;
+      for (size_t i = 1; i < d.pixels.size(); ++i)
+        EXPECT_GT((d.pixels[i] - Eigen::Vector2d(x, y)).norm(), 6.0) << x << " " << y;
+    }
+  }
+  EXPECT_GT(red, 50);  // the label is there
+}
+
 struct SimCase {
   rig::DistortionModel model;
   std::vector<double> left_coeffs, right_coeffs;
