@@ -32,26 +32,11 @@ void run(Options o) {
       o.fix_correlation == "auto" ? -1.0 : parse_double(o.fix_correlation, "--fix-correlation");
   if (o.windows != std::pair<size_t, size_t>{0, 0})
     std::tie(o.step.ba.first_window, o.step.ba.end_window) = o.windows;
-  const gt::StepInputs in = gt::step_inputs(o.in, o.step, console_progress());
-  const gt::GroundTruthPaths paths = gt::ground_truth_paths(o.out, o.sigmas, o.report, o.map, in);
-  const gt::GroundTruthRun run = gt::run_ground_truth(in, o.step, console_progress());
-  const gt::PoseGraphResult& g = run.graph;
-  const nlohmann::json report = gt::ground_truth_report(run, in);
-  fmt::print("{}", gt::ground_truth_summary(run, report));
-  const std::vector<io::OutputFile> files = gt::ground_truth_files(run, report, paths);
-  io::write_files_atomic(files);
-  if (run.chunk_motions) {
-    for (const io::OutputFile& f : files) fmt::print("wrote {}\n", f.path.string());
-    return;
-  }
-  for (const gt::Undetermined& u : g.undetermined)
-    fmt::print(stderr, "undetermined: {}: {}\n", u.what, u.why);
-  if (!g.T_enu_lidar.empty()) {
-    fmt::print("wrote {} (T_enu_lidar at each scan's stamp, VBR's ground-truth format){}{}\n",
-               o.out, g.covariance.empty() ? "" : ", " + paths.sigmas.string(),
-               o.report.empty() ? "" : "; report " + paths.report.string());
-  }
-  if (g.T_enu_lidar.empty() || !g.undetermined.empty()) throw Exit{3};
+  const gt::CommandOutcome r =
+      gt::ground_truth_command(o.in, o.step, o.out, o.sigmas, o.report, o.map, console_progress());
+  fmt::print("{}", r.text);
+  for (const std::string& line : r.undetermined) fmt::print(stderr, "{}\n", line);
+  if (r.exit_status != 0) throw Exit{r.exit_status};
 }
 
 }  // namespace ground_truth_command
@@ -62,19 +47,12 @@ void add_ground_truth(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "ground-truth",
       "The LiDAR's ground-truth trajectory (doc/ground-truth.md): a pose graph over the scan\n"
-      "poses with the odometry's steps weighted by their covariances and the GNSS fixes as\n"
-      "position priors through the lever arm (robust solve, a chi-square gate, a second\n"
-      "solve). Writes OUT (VBR's <seq>_gt.txt: T_enu_lidar, ENU at the first fix or at\n"
-      "--enu-origin) and each pose's sigmas. Then, when the scans are there, the geometric\n"
-      "LiDAR bundle adjustment: overlapping windows of scans, each sweep deskewed by the\n"
-      "motion it estimates, the points brought onto planar patches; the windows' motions\n"
-      "replace the odometry's in the pose graph, solved again with the same priors. With\n"
-      "--map or --markers, the scans\n"
-      "placed by the result: the map, and the survey markers found in it as clusters of\n"
-      "bright points, their distances against the survey's. Exit 3 when the fixes leave\n"
-      "something undetermined (said on stderr). A job array (doc/performance.md): each task\n"
-      "runs --windows FROM:TO (OUT: its motions), then one run joins them with\n"
-      "--window-motions.");
+      "poses (the odometry's steps, the GNSS fixes as priors through the lever arm), then the\n"
+      "LiDAR bundle adjustment over overlapping windows of the scans, solved again. Writes OUT\n"
+      "(VBR's <seq>_gt.txt: T_enu_lidar) and each pose's sigmas; the map and the survey\n"
+      "markers' distances with --map / --markers. Exit 3 when the fixes leave something\n"
+      "undetermined (said on stderr). A job array: --windows FROM:TO a task, --window-motions\n"
+      "the join (doc/performance.md).");
   cmd->add_option("recording", o->in.recording,
                   "the recording: its gnss/ (poses.tum, fixes.csv or navsat.csv) and its scans "
                   "(ouster_points/, a capture, a session): the odometry's without --odometry, "

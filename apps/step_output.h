@@ -42,11 +42,11 @@ inline report::Progress console_progress() {
 // step is ok, the rig into `out` (when given), then the warnings. Undetermined: the report is
 // written, the reason and the remedy go to stderr, and the command exits 3 with `out` not written.
 inline void finish_step(const report::StepResult& r, const std::string& out,
-                        const std::string& report_dir, double seconds = 0) {
+                        const std::string& report_dir) {
   std::vector<io::OutputFile> files;
   if (!report_dir.empty()) {
     files = report::report_files_in(r, report_dir);
-    files.push_back(session::step_run_file(r, report_dir, seconds));
+    files.push_back(session::step_run_file(r, report_dir));
   }
   // The page a person reads, rendered from those files once they are written.
   const auto write_page = [&] {

@@ -210,6 +210,8 @@ nlohmann::json stereo_rectification(const CalibrationResult& r, const Detections
           {"row_difference_rms_px", rms(rows)},
           {"row_difference_median_abs_px", median(magnitudes)},
           {"expected_rms_px", std::sqrt(2.0) * r.rms_coord_px},
+          // The warning's rule: more than twice the noise's RMS, and 0.1 px.
+          {"exceeds_noise", rms(rows) > 2 * std::sqrt(2.0) * r.rms_coord_px + 0.1},
           {"figure_view_left", images[0][best]},
           {"figure_view_right", images[1][best]},
           {"figure", "stereo_rectified.png"}};
@@ -316,8 +318,8 @@ report::StepResult calibrate_cameras(const StepInputs& in, const StepOptions& o,
         stereo_rectification(r, d, in.images.files, o.bayer, out.report_files);
     if (!rect.is_null()) {
       out.report["stereo_rectification"] = rect;
-      const double rms = rect["row_difference_rms_px"], expected = rect["expected_rms_px"];
-      if (rms > 2 * expected + 0.1) {
+      if (rect["exceeds_noise"].get<bool>()) {
+        const double rms = rect["row_difference_rms_px"], expected = rect["expected_rms_px"];
         out.warnings.push_back(fmt::format(
             "rectified with this estimate, the corners both cameras saw differ by {:.3f} px RMS "
             "in row, more than twice the {:.3f} px their noise gives: the stereo extrinsic or a "
@@ -359,42 +361,29 @@ report::StepResult calibrate_cameras(const StepInputs& in, const StepOptions& o,
                    {"outlier_corners", static_cast<double>(r.n_outliers), ""},
                    {"corners", static_cast<double>(r.residuals.size()), ""}};
   if (at_rig) out.residuals.push_back({"rms_2d_at_rig_px", at_rig->rms_2d_px, "px"});
+  // The sigmas and their correlations, from the blocks of the solve's covariance: each lens's
+  // fx fy cx cy, then each camera pose after camera 0's (its rotation tangent is Ceres'
+  // quaternion one, half the angle: scaled to rigcal's).
   static const char* kIntrinsics[] = {"fx", "fy", "cx", "cy"};
-  for (size_t c = 0; c < n_cams; ++c) {
-    for (int i = 0; i < 4; ++i) {
-      out.sigmas.push_back(
-          {fmt::format("{}.{}", names[c], kIntrinsics[i]), r.cameras[c].stddev[i], "px"});
-    }
-  }
-  for (size_t c = 1; c < n_cams; ++c) {
-    const std::string T = fmt::format("T_{}_{}", names[c], names[0]);
-    for (int a = 0; a < 3; ++a) {
-      out.sigmas.push_back(
-          {fmt::format("{}.t.{}", T, "xyz"[a]), r.translation_stddev_m[c][a], "m"});
-    }
-    for (int a = 0; a < 3; ++a) {
-      out.sigmas.push_back(
-          {fmt::format("{}.rotation.{}", T, "xyz"[a]), r.rotation_stddev_deg[c][a], "deg"});
-    }
-  }
-  // Their correlations, from the blocks of the solve's covariance: each lens's fx fy cx cy, and
-  // each camera pose after camera 0's (rotation, then translation).
   const Eigen::Index NK = static_cast<Eigen::Index>(r.cameras[0].stddev.size());
-  for (size_t c = 0; c < n_cams && r.covariance.rows() > 0; ++c) {
+  for (size_t c = 0; c < n_cams; ++c) {
     std::vector<std::string> keys;
-    for (int i = 0; i < 4; ++i) keys.push_back(fmt::format("{}.{}", names[c], kIntrinsics[i]));
+    for (int i = 0; i < 4; ++i) {
+      keys.push_back(fmt::format("{}.{}", names[c], kIntrinsics[i]));
+      out.sigmas.push_back({keys.back(), r.cameras[c].stddev[i], "px"});
+    }
     const Eigen::Index at = static_cast<Eigen::Index>(c) * NK;
     out.correlations.push_back(
         report::correlation_of(names[c], keys, r.covariance.block(at, at, 4, 4)));
   }
-  for (size_t c = 1; c < n_cams && r.covariance.rows() > 0; ++c) {
-    const std::string T = fmt::format("T_{}_{}", names[c], names[0]);
-    std::vector<std::string> keys;
-    for (const char* part : {"rotation", "t"})
-      for (int a = 0; a < 3; ++a) keys.push_back(fmt::format("{}.{}.{}", T, part, "xyz"[a]));
+  for (size_t c = 1; c < n_cams; ++c) {
     const Eigen::Index at =
         static_cast<Eigen::Index>(n_cams) * NK + 6 * static_cast<Eigen::Index>(c - 1);
-    out.correlations.push_back(report::correlation_of(T, keys, r.covariance.block(at, at, 6, 6)));
+    Eigen::Matrix<double, 6, 6> covariance = r.covariance.block(at, at, 6, 6);
+    covariance.topRows<3>() *= 2.0;
+    covariance.leftCols<3>() *= 2.0;
+    report::add_pose_uncertainty(out.sigmas, out.correlations,
+                                 fmt::format("T_{}_{}", names[c], names[0]), covariance);
   }
   out.inputs.push_back({"target", in.target});
   for (size_t c = 0; c < n_cams; ++c) {

@@ -669,4 +669,35 @@ std::vector<io::OutputFile> ground_truth_files(const GroundTruthRun& run,
   return files;
 }
 
+CommandOutcome ground_truth_command(const InputFiles& files, const StepOptions& options,
+                                    const std::filesystem::path& out,
+                                    const std::filesystem::path& sigmas,
+                                    const std::filesystem::path& report_dir,
+                                    const std::filesystem::path& map,
+                                    const report::Progress& progress) {
+  const StepInputs in = step_inputs(files, options, progress);
+  const GroundTruthPaths paths = ground_truth_paths(out, sigmas, report_dir, map, in);
+  const GroundTruthRun run = run_ground_truth(in, options, progress);
+  const PoseGraphResult& g = run.graph;
+  const nlohmann::json report = ground_truth_report(run, in);
+  CommandOutcome o;
+  o.text = ground_truth_summary(run, report);
+  const std::vector<io::OutputFile> written = ground_truth_files(run, report, paths);
+  io::write_files_atomic(written);
+  if (run.chunk_motions) {
+    for (const io::OutputFile& f : written) o.text += fmt::format("wrote {}\n", f.path.string());
+    return o;
+  }
+  for (const Undetermined& u : g.undetermined)
+    o.undetermined.push_back(fmt::format("undetermined: {}: {}", u.what, u.why));
+  if (!g.T_enu_lidar.empty()) {
+    o.text +=
+        fmt::format("wrote {} (T_enu_lidar at each scan's stamp, VBR's ground-truth format){}{}\n",
+                    out.string(), g.covariance.empty() ? "" : ", " + paths.sigmas.string(),
+                    report_dir.empty() ? "" : "; report " + paths.report.string());
+  }
+  o.exit_status = g.T_enu_lidar.empty() || !g.undetermined.empty() ? 3 : 0;
+  return o;
+}
+
 }  // namespace rigcal::gt

@@ -163,4 +163,20 @@ GroundTruthPaths ground_truth_paths(const std::filesystem::path& out,
                                     const std::filesystem::path& report_dir,
                                     const std::filesystem::path& map, const StepInputs& inputs);
 
+// A whole `rigcal ground-truth` run: the inputs read, the run, its files written (all or none),
+// and what it says: `text` for stdout, `undetermined` lines for stderr, the exit status (0, or 3
+// when the fixes leave something undetermined or place no pose). Throws as step_inputs,
+// ground_truth_paths and run_ground_truth do.
+struct CommandOutcome {
+  std::string text;
+  std::vector<std::string> undetermined;
+  int exit_status = 0;
+};
+CommandOutcome ground_truth_command(const InputFiles& files, const StepOptions& options,
+                                    const std::filesystem::path& out,
+                                    const std::filesystem::path& sigmas,
+                                    const std::filesystem::path& report_dir,
+                                    const std::filesystem::path& map,
+                                    const report::Progress& progress = {});
+
 }  // namespace rigcal::gt

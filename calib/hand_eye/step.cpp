@@ -338,16 +338,7 @@ report::StepResult estimate(const StepInputs& in, const StepOptions& o, const Tr
     if (o.estimate_offset) rig::set_clock_from(out.rig, o.sensor, o.lidar_sensor, offset_s);
   }
   const std::string name = fmt::format("T_{}_{}", o.sensor, o.lidar_sensor);
-  for (int a = 0; a < 3; ++a)
-    out.sigmas.push_back({fmt::format("{}.t.{}", name, "xyz"[a]), sig_t[a], "m"});
-  for (int a = 0; a < 3; ++a)
-    out.sigmas.push_back({fmt::format("{}.rotation.{}", name, "xyz"[a]), sig_r[a], "deg"});
-  {
-    std::vector<std::string> names;  // the covariance's order: rotation, then translation
-    for (const char* part : {"rotation", "t"})
-      for (int a = 0; a < 3; ++a) names.push_back(fmt::format("{}.{}.{}", name, part, "xyz"[a]));
-    out.correlations.push_back(report::correlation_of(name, names, r.covariance));
-  }
+  report::add_pose_uncertainty(out.sigmas, out.correlations, name, r.covariance);
   if (o.estimate_offset)
     out.sigmas.push_back({o.sensor + ".time_offset", r.time_offset_sigma_s, "s"});
   out.residuals = {{"pairs", static_cast<double>(pairs.size()), ""},

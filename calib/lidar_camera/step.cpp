@@ -208,16 +208,7 @@ report::StepResult calibrate_lidar_camera(const StepInputs& in, const StepOption
     out.residuals.push_back({"distance_rms_at_rig_m", distance_rms_m, "m"});
   }
   const std::string name = fmt::format("T_{}_{}", o.camera, o.lidar);
-  for (int a = 0; a < 3; ++a)
-    out.sigmas.push_back({fmt::format("{}.t.{}", name, "xyz"[a]), s.translation_sigma_m[a], "m"});
-  for (int a = 0; a < 3; ++a) {
-    out.sigmas.push_back(
-        {fmt::format("{}.rotation.{}", name, "xyz"[a]), s.rotation_sigma_deg[a], "deg"});
-  }
-  std::vector<std::string> names;  // the covariance's order: rotation, then translation
-  for (const char* part : {"rotation", "t"})
-    for (int a = 0; a < 3; ++a) names.push_back(fmt::format("{}.{}.{}", name, part, "xyz"[a]));
-  out.correlations.push_back(report::correlation_of(name, names, s.covariance));
+  report::add_pose_uncertainty(out.sigmas, out.correlations, name, s.covariance);
   out.inputs.push_back({"target", in.target});
   for (size_t k = 0; k < in.images.size(); ++k) {
     out.inputs.push_back({"images", in.images[k]});

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -27,6 +28,21 @@ Correlation correlation_of(std::string name, std::vector<std::string> names,
     }
   }
   return c;
+}
+
+void add_pose_uncertainty(std::vector<Figure>& sigmas, std::vector<Correlation>& correlations,
+                          const std::string& name, const Eigen::Matrix<double, 6, 6>& covariance) {
+  const auto sigma = [&](int i) { return std::sqrt(std::max(0.0, covariance(i, i))); };
+  for (int a = 0; a < 3; ++a)
+    sigmas.push_back({fmt::format("{}.t.{}", name, "xyz"[a]), sigma(3 + a), "m"});
+  for (int a = 0; a < 3; ++a) {
+    sigmas.push_back(
+        {fmt::format("{}.rotation.{}", name, "xyz"[a]), sigma(a) * 180.0 / M_PI, "deg"});
+  }
+  std::vector<std::string> names;  // the covariance's order: rotation, then translation
+  for (const char* part : {"rotation", "t"})
+    for (int a = 0; a < 3; ++a) names.push_back(fmt::format("{}.{}.{}", name, part, "xyz"[a]));
+  correlations.push_back(correlation_of(name, names, covariance));
 }
 
 void finish_report(StepResult& r, std::string_view json_file, const nlohmann::json& extra) {

@@ -41,6 +41,12 @@ struct Correlation {
 Correlation correlation_of(std::string name, std::vector<std::string> names,
                            const Eigen::MatrixXd& covariance);
 
+// A pose T_a_b's 1-sigmas into `sigmas` (translation "<name>.t.x" m, then rotation
+// "<name>.rotation.x" deg, about a's axes) and its correlation into `correlations`, from its
+// 6 x 6 covariance in rigcal's tangent (rotation rad on the left, then translation m).
+void add_pose_uncertainty(std::vector<Figure>& sigmas, std::vector<Correlation>& correlations,
+                          const std::string& name, const Eigen::Matrix<double, 6, 6>& covariance);
+
 // An input file or folder the step read (the session pipeline hashes them for provenance and
 // its cache).
 struct Input {

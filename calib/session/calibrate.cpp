@@ -588,9 +588,8 @@ StepRun step_run(const report::StepResult& r) {
   return run;
 }
 
-io::OutputFile step_run_file(const report::StepResult& r, const fs::path& dir, double seconds) {
-  StepRun run = step_run(r);
-  run.seconds = seconds;
+io::OutputFile step_run_file(const report::StepResult& r, const fs::path& dir) {
+  const StepRun run = step_run(r);
   nlohmann::json j;
   j["tool_version"] = version_string();
   j["run"] = run_json(run);

@@ -66,8 +66,7 @@ StepRun step_run(const report::StepResult& r);
 // A single step's command with a report folder (`rigcal cameras --report DIR`): DIR/run.json,
 // the step's run as OUT/reports/calibrate.json holds each step's, from which `render_report`
 // (report_html.h) renders DIR/report.html.
-io::OutputFile step_run_file(const report::StepResult& r, const std::filesystem::path& dir,
-                             double seconds);
+io::OutputFile step_run_file(const report::StepResult& r, const std::filesystem::path& dir);
 
 struct CalibrateResult {
   std::vector<StepRun> steps;

@@ -284,14 +284,13 @@ std::string cameras_section(const json& j, const fs::path& dir) {
   }
   if (j.contains("stereo_rectification") && j["stereo_rectification"].is_object()) {
     const json& r = j["stereo_rectification"];
-    const double rms = r["row_difference_rms_px"], expected = r["expected_rms_px"];
     out += fmt::format(
         "<p><b>Rectified</b> with this estimate, the {} corners both cameras saw lie on the same "
         "row within {} px RMS (median {} px); the corner noise alone gives about {} px{}.</p>\n",
         html_number(r["corners"], "{:.0f}"), html_number(r["row_difference_rms_px"], "{:.3f}"),
         html_number(r["row_difference_median_abs_px"], "{:.3f}"),
         html_number(r["expected_rms_px"], "{:.3f}"),
-        rms > 2 * expected + 0.1
+        r.value("exceeds_noise", false)
             ? ": <b>more than twice that: the stereo extrinsic or a lens does not fit these "
               "views</b>"
             : "");

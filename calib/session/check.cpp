@@ -208,8 +208,9 @@ CheckResult check(const rig::Rig& stored, const std::filesystem::path& stored_fi
   std::erase_if(meta, [](const auto& kv) { return kv.first == "steps"; });
   meta.emplace_back("steps", steps_yaml(new_records));
   out.difference = diff_rigs(stored, estimate);
-  const std::map<std::string, double> sigmas_a = stored_sigmas(stored),
-                                      sigmas_b = stored_sigmas(estimate);
+  // The records already read: the stored calibration's and the re-estimate's.
+  const std::map<std::string, double> sigmas_a = uncertainty_of(records).sigma,
+                                      sigmas_b = uncertainty_of(new_records).sigma;
 
   for (const Quantity& q : stored_quantities) {
     Verdict v;

@@ -35,41 +35,30 @@ std::optional<Significance> significance(const std::vector<double>& difference,
   Significance s;
   s.sigma.assign(difference.size(), NAN);
   s.conditional_sigma.assign(difference.size(), NAN);
+  // The covariance of components i and j stored by one calibration (0 where it has no sigma).
+  const auto covariance = [&](const StoredUncertainty& u, size_t i, size_t j) {
+    const auto si = u.sigma.find(keys[i]), sj = u.sigma.find(keys[j]);
+    if (si == u.sigma.end() || sj == u.sigma.end()) return 0.0;
+    return u.correlation(keys[i], keys[j]) * si->second * to_si[i] * sj->second * to_si[j];
+  };
+  // The components with a variance (a sigma of 0 stored, or none, says nothing).
   for (size_t i = 0; i < difference.size(); ++i) {
-    if (a.sigma.count(keys[i]) || b.sigma.count(keys[i])) s.components.push_back(i);
+    const double v = covariance(a, i, i) + covariance(b, i, i);
+    if (v > 0 && std::isfinite(v)) s.components.push_back(i);
   }
-  const Eigen::Index n = static_cast<Eigen::Index>(s.components.size());
-  Eigen::MatrixXd C = Eigen::MatrixXd::Zero(n, n);
-  Eigen::VectorXd d(n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const size_t ci = s.components[size_t(i)];
-    d[i] = difference[ci];
-    for (Eigen::Index j = 0; j < n; ++j) {
-      const size_t cj = s.components[size_t(j)];
-      for (const StoredUncertainty* u : {&a, &b}) {
-        const auto si = u->sigma.find(keys[ci]), sj = u->sigma.find(keys[cj]);
-        if (si == u->sigma.end() || sj == u->sigma.end()) continue;
-        const double rho = u->correlation(keys[ci], keys[cj]);
-        if (i != j && rho != 0) s.correlated = true;
-        C(i, j) += rho * si->second * to_si[ci] * sj->second * to_si[cj];
-      }
-    }
-  }
-  // Components with no variance (a sigma of 0 stored) say nothing: left out.
-  std::vector<Eigen::Index> keep;
-  for (Eigen::Index i = 0; i < n; ++i)
-    if (C(i, i) > 0 && std::isfinite(C(i, i))) keep.push_back(i);
-  if (keep.empty()) return std::nullopt;
-  const Eigen::Index m = static_cast<Eigen::Index>(keep.size());
+  if (s.components.empty()) return std::nullopt;
+  const Eigen::Index m = static_cast<Eigen::Index>(s.components.size());
   Eigen::MatrixXd Ck(m, m);
   Eigen::VectorXd dk(m);
-  std::vector<size_t> kept;
   for (Eigen::Index i = 0; i < m; ++i) {
-    dk[i] = d[keep[size_t(i)]];
-    kept.push_back(s.components[size_t(keep[size_t(i)])]);
-    for (Eigen::Index j = 0; j < m; ++j) Ck(i, j) = C(keep[size_t(i)], keep[size_t(j)]);
+    const size_t ci = s.components[size_t(i)];
+    dk[i] = difference[ci];
+    for (Eigen::Index j = 0; j < m; ++j) {
+      const size_t cj = s.components[size_t(j)];
+      Ck(i, j) = covariance(a, ci, cj) + covariance(b, ci, cj);
+      if (i != j && Ck(i, j) != 0) s.correlated = true;
+    }
   }
-  s.components = kept;
   // The whitening W (W' W = C^-1) from C's eigen-decomposition; directions with no variance to
   // speak of (stored correlations of +-1 within rounding) are given a floor of 1e-12 of the
   // largest.
@@ -79,8 +68,8 @@ std::optional<Significance> significance(const std::vector<double>& difference,
   s.whiten = inv_sqrt.asDiagonal() * eig.eigenvectors().transpose();
   const Eigen::MatrixXd information = s.whiten.transpose() * s.whiten;
   for (Eigen::Index i = 0; i < m; ++i) {
-    s.sigma[kept[size_t(i)]] = std::sqrt(Ck(i, i));
-    s.conditional_sigma[kept[size_t(i)]] = 1.0 / std::sqrt(information(i, i));
+    s.sigma[s.components[size_t(i)]] = std::sqrt(Ck(i, i));
+    s.conditional_sigma[s.components[size_t(i)]] = 1.0 / std::sqrt(information(i, i));
   }
   s.chi2 = (s.whiten * dk).squaredNorm();
   s.dof = static_cast<int>(m);

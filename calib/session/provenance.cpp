@@ -166,25 +166,31 @@ double StoredUncertainty::correlation(const std::string& a, const std::string& b
   return it == rho.end() ? 0.0 : it->second;
 }
 
-StoredUncertainty stored_uncertainty(const rig::Rig& rig) {
+StoredUncertainty uncertainty_of(const std::vector<StepRecord>& records) {
   StoredUncertainty out;
-  for (const StepRecord& s : read_steps(rig)) {
-    for (const report::Figure& f : s.sigmas) out.sigma[f.name] = f.value;
+  for (const StepRecord& s : records) {
+    // By the keys they are (or would be) stored under: a record read back has them as names.
+    std::map<std::string, std::string> key_of;
+    for (const report::Figure& f : s.sigmas) {
+      key_of[f.name] = figure_key(f);
+      out.sigma[figure_key(f)] = f.value;
+    }
+    const auto key = [&](const std::string& name) {
+      const auto it = key_of.find(name);
+      return it == key_of.end() ? name : it->second;
+    };
     for (const report::Correlation& c : s.correlations) {
       const size_t n = c.names.size();
       for (size_t i = 0; i < n; ++i)
         for (size_t j = 0; j < n; ++j)
-          if (i != j) out.rho[{c.names[i], c.names[j]}] = c.rho[i * n + j];
+          if (i != j) out.rho[{key(c.names[i]), key(c.names[j])}] = c.rho[i * n + j];
     }
   }
   return out;
 }
 
-std::map<std::string, double> stored_sigmas(const rig::Rig& rig) {
-  std::map<std::string, double> out;
-  for (const StepRecord& s : read_steps(rig))
-    for (const report::Figure& f : s.sigmas) out[f.name] = f.value;
-  return out;
+StoredUncertainty stored_uncertainty(const rig::Rig& rig) {
+  return uncertainty_of(read_steps(rig));
 }
 
 }  // namespace rigcal::session

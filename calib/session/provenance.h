@@ -38,10 +38,6 @@ std::string steps_yaml(const std::vector<StepRecord>& records);
 // is not of this shape.
 std::vector<StepRecord> read_steps(const rig::Rig& rig);
 
-// Every 1-sigma the steps of a calibration stored, by the key it was written under
-// ("T_cam_r_lidar.t.x_m", "cam_l.fx_px", "imu.time_offset_s").
-std::map<std::string, double> stored_sigmas(const rig::Rig& rig);
-
 // The stored sigmas with the correlations among them (those a step stored: within one quantity).
 struct StoredUncertainty {
   std::map<std::string, double> sigma;                        // by key, as stored_sigmas
@@ -49,6 +45,10 @@ struct StoredUncertainty {
   // The correlation of two keys: 1 for a key with itself, 0 where none is stored.
   double correlation(const std::string& a, const std::string& b) const;
 };
+// Every 1-sigma the steps stored, by the key it was written under ("T_cam_r_lidar.t.x_m",
+// "cam_l.fx_px", "imu.time_offset_s"), with their correlations: of records already read, or of a
+// calibration.
+StoredUncertainty uncertainty_of(const std::vector<StepRecord>& records);
 StoredUncertainty stored_uncertainty(const rig::Rig& rig);
 
 // "name_unit" unless the name ends with the unit already: the key a figure is written under.
