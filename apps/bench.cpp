@@ -84,7 +84,7 @@ void add_bench(CLI::App& app) {
   cmd->add_option(
       "--duplicate-stamps", o->duplicates,
       "poses with equal stamps: error | drop (keep the first) | keep (default: keep for\n"
-      "the vbr convention, as its evaluator does; error otherwise)");
+      "the evo and vbr conventions, as those tools do; error otherwise)");
   cmd->add_option("--report", o->report, "folder for bench.json (every figure) and SVG plots");
   cmd->add_option("--gt-dir", o->gt_dir, "leaderboard: folder of <seq>_gt.txt");
   cmd->add_option("--est-dir", o->est_dir, "leaderboard: folder of <method>/<seq>_es.txt");

@@ -322,7 +322,15 @@ EvalResult evaluate(Trajectory gt, Trajectory est, const EvalOptions& opt) {
     m_stamps = std::move(gt.stamps);
   } else {
     Matches m;
-    if (res.association == Association::nearest) {
+    if (res.association == Association::nearest && opt.convention == Convention::evo) {
+      m = associate_evo_seconds(evo_seconds(gt.stamps, opt.gt_stamps_ns),
+                                evo_seconds(est.stamps, opt.est_stamps_ns), opt.max_diff.seconds());
+      res.notes.push_back(fmt::format(
+          "each stamp of the shorter trajectory takes the nearest of the longer within {} s, in "
+          "float64 seconds as evo reads them, the first of equal stamps (evo's rule, not "
+          "one-to-one)",
+          opt.max_diff.seconds()));
+    } else if (res.association == Association::nearest) {
       m = associate_evo(gt, est, opt.max_diff);
       res.notes.push_back(fmt::format(
           "each stamp of the shorter trajectory takes the nearest of the longer within {} s "

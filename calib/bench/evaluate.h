@@ -37,6 +37,9 @@ struct EvalOptions {
   DeltaUnit delta_unit = DeltaUnit::frames;   // ... in frames or metres
   bool all_pairs = false;                     // evo's --all_pairs
   bool keep_segments = false;                 // keep per-segment rows (plots, reports)
+  // evo compares the float64 seconds it reads: decimal seconds, or integer nanoseconds (EuRoC)
+  // read as a float64 and divided by 1e9. True when the file gave nanoseconds.
+  bool gt_stamps_ns = false, est_stamps_ns = false;
 };
 
 struct RpeResult {

@@ -4,6 +4,7 @@
 
 #include <Eigen/SVD>
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <numeric>
 
@@ -45,6 +46,7 @@ std::vector<std::pair<size_t, size_t>> nearest_stamps(const std::vector<Time>& a
     while (j < b.size() && b[j] < a[i]) ++j;
     size_t best = j;
     if (j == b.size() || (j > 0 && (a[i] - b[j - 1]) <= (b[j] - a[i]))) best = j - 1;
+    while (best > 0 && best < j && b[best - 1] == b[best]) --best;  // the first of equal stamps
     const Time diff = a[i] < b[best] ? b[best] - a[i] : a[i] - b[best];
     if (diff <= max_diff) pairs.emplace_back(i, best);
   }
@@ -56,6 +58,63 @@ Matches associate_evo(const Trajectory& gt, const Trajectory& est, Time max_diff
   const bool est_longer = est.size() > gt.size();
   const auto pairs = est_longer ? nearest_stamps(gt.stamps, est.stamps, max_diff)
                                 : nearest_stamps(est.stamps, gt.stamps, max_diff);
+  for (const auto& [short_i, long_i] : pairs) {
+    m.gt.push_back(est_longer ? short_i : long_i);
+    m.est.push_back(est_longer ? long_i : short_i);
+  }
+  return m;
+}
+
+std::vector<std::pair<size_t, size_t>> nearest_seconds(const std::vector<double>& a,
+                                                       const std::vector<double>& b,
+                                                       double max_diff) {
+  std::vector<std::pair<size_t, size_t>> pairs;
+  pairs.reserve(std::min(a.size(), b.size()));
+  if (b.empty()) return pairs;
+  size_t j = 0;  // first stamp of b that is >= the current stamp of a
+  for (size_t i = 0; i < a.size(); ++i) {
+    const double t = a[i];
+    while (j < b.size() && b[j] < t) ++j;
+    // Rounded differences are monotone on each side of t, so the smallest is at j - 1 or j, and
+    // an earlier stamp below t can only tie with j - 1: numpy's argmin takes the first of a tie.
+    const double d_hi = j < b.size() ? std::abs(b[j] - t) : INFINITY;
+    const double d_lo = j > 0 ? std::abs(b[j - 1] - t) : INFINITY;
+    size_t best = j;
+    double d = d_hi;
+    if (j > 0 && d_lo <= d_hi) {
+      d = d_lo;
+      best = j - 1;
+      if (best > 0 && std::abs(b[best - 1] - t) <= d_lo) {
+        best = static_cast<size_t>(
+            std::partition_point(b.begin(), b.begin() + static_cast<std::ptrdiff_t>(j),
+                                 [&](double s) { return std::abs(s - t) > d_lo; }) -
+            b.begin());
+      }
+    }
+    if (d <= max_diff) pairs.emplace_back(i, best);
+  }
+  return pairs;
+}
+
+std::vector<double> evo_seconds(const std::vector<Time>& stamps, bool read_as_ns) {
+  std::vector<double> out(stamps.size());
+  for (size_t i = 0; i < stamps.size(); ++i) {
+    if (read_as_ns) {
+      out[i] = static_cast<double>(stamps[i].ns) / 1e9;
+    } else {
+      const std::string text = to_seconds_text(stamps[i]);
+      std::from_chars(text.data(), text.data() + text.size(), out[i]);
+    }
+  }
+  return out;
+}
+
+Matches associate_evo_seconds(const std::vector<double>& gt_seconds,
+                              const std::vector<double>& est_seconds, double max_diff) {
+  Matches m;
+  const bool est_longer = est_seconds.size() > gt_seconds.size();
+  const auto pairs = est_longer ? nearest_seconds(gt_seconds, est_seconds, max_diff)
+                                : nearest_seconds(est_seconds, gt_seconds, max_diff);
   for (const auto& [short_i, long_i] : pairs) {
     m.gt.push_back(est_longer ? short_i : long_i);
     m.est.push_back(est_longer ? long_i : short_i);

@@ -24,8 +24,22 @@ struct Matches {
 // Several stamps of `a` may take the same stamp of `b` (evo's rule). Returned as (a, b) pairs.
 std::vector<std::pair<size_t, size_t>> nearest_stamps(const std::vector<Time>& a,
                                                       const std::vector<Time>& b, Time max_diff);
-// evo: the shorter trajectory's stamps each take their nearest in the longer one.
+// evo: the shorter trajectory's stamps each take their nearest in the longer one (the estimate's
+// when both have as many), in exact arithmetic; among equal stamps, the first.
 Matches associate_evo(const Trajectory& gt, const Trajectory& est, Time max_diff);
+
+// evo's association in evo's own arithmetic (evo.core.sync.matching_time_indices): stamps as the
+// float64 seconds evo reads, and for each stamp of `a` the first stamp of `b` whose float64
+// |difference| is smallest (numpy's argmin: among equal differences the first in file order),
+// kept when that difference is <= max_diff. Both non-decreasing. Returned as (a, b) pairs.
+std::vector<std::pair<size_t, size_t>> nearest_seconds(const std::vector<double>& a,
+                                                       const std::vector<double>& b,
+                                                       double max_diff);
+// The float64 seconds evo reads: the decimal seconds correctly rounded (TUM: the text through
+// float()), or integer nanoseconds read as float64 then divided by 1e9 (EuRoC).
+std::vector<double> evo_seconds(const std::vector<Time>& stamps, bool read_as_ns);
+Matches associate_evo_seconds(const std::vector<double>& gt_seconds,
+                              const std::vector<double>& est_seconds, double max_diff);
 // One-to-one (TUM associate.py): all pairs within max_diff, taken greedily by increasing |dt|.
 Matches associate_one_to_one(const Trajectory& gt, const Trajectory& est, Time max_diff);
 // By index, for files without stamps: the first min(N, M) poses.

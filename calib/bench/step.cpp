@@ -24,9 +24,11 @@ io::TrajectoryReadOptions read_options(const BenchOptions& o, const std::string&
   io::TrajectoryReadOptions r;
   r.format = io::trajectory_format_from_string(format.empty() ? o.format : format);
   r.kitti_times = times;
-  // The VBR evaluator reads every line, equal stamps included; the others refuse them by default.
-  r.duplicates = io::duplicates_from_string(
-      o.duplicates.empty() ? (o.convention == "vbr" ? "keep" : "error") : o.duplicates);
+  // evo and the VBR evaluator read every line, equal stamps included; the others refuse them by
+  // default.
+  const bool peer_keeps = o.convention == "vbr" || o.convention == "evo";
+  r.duplicates = io::duplicates_from_string(o.duplicates.empty() ? (peer_keeps ? "keep" : "error")
+                                                                 : o.duplicates);
   return r;
 }
 
@@ -56,8 +58,12 @@ PairRun score_pair(const BenchOptions& o) {
   PairRun run;
   run.gt = io::read_trajectory(o.gt, read_options(o, o.gt_format, o.gt_times));
   run.est = io::read_trajectory(o.est, read_options(o, o.est_format, o.est_times));
+  EvalOptions with_formats = options;
+  with_formats.gt_stamps_ns = run.gt.format == io::TrajectoryFormat::euroc;
+  with_formats.est_stamps_ns = run.est.format == io::TrajectoryFormat::euroc;
   try {
-    run.result = evaluate(std::move(run.gt.trajectory), std::move(run.est.trajectory), options);
+    run.result =
+        evaluate(std::move(run.gt.trajectory), std::move(run.est.trajectory), with_formats);
   } catch (const Error& e) {
     throw Error(fmt::format("{} against {}: {}", o.est, o.gt, e.what()));
   }

@@ -1,6 +1,7 @@
 // The benchmark against its peers on real public data (../shared/fixtures/trajectories; figures
 // from MANIFEST.md and the issue): evo, the KITTI devkit in double, the VBR evaluator; and ATE on
 // other real pairs against a reference computed here by a different code path.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -10,6 +11,7 @@
 #include "fixtures.h"
 #include "rigcal/bench/evaluate.h"
 #include "rigcal/bench/leaderboard.h"
+#include "rigcal/bench/step.h"
 #include "rigcal/io/trajectory_io.h"
 
 namespace rigcal::bench {
@@ -62,6 +64,82 @@ TEST(BenchPeers, EvoOnKitti00MatchesToOneBillionth) {
   // no alignment
   o.alignment = Alignment::none;
   EXPECT_REL(evaluate(gt, est, o).ate_trans.rmse, 7.7902889, 1e-7);
+}
+
+// evo 1.36.5 (the fixtures' commit, run from its source with Debian's numpy) on every TUM and
+// EuRoC pair of its test data, figures from the zip's stats.json (full float64 digits): APE with
+// and without -a and -s, RPE -d 1 -u f, translation and angle_deg. The files are given as a user
+// gives them to `rigcal bench --convention evo`: fr2_desk's ground truth and V102.txt repeat
+// stamps, which evo reads as they are.
+TEST(BenchPeers, EvoOnEveryTumAndEurocFixtureToOneBillionth) {
+  RIGCAL_REQUIRE_FIXTURE(dir, "trajectories/evo");
+  struct Row {
+    const char *gt, *est, *align;
+    bool rpe, angle;
+    size_t n;
+    double rmse, mean, median, std, min, max;
+  };
+  const char* fr2_gt = "fr2_desk_groundtruth.txt";
+  const char* fr2_es = "fr2_desk_ORB.txt";
+  const char* fr1_gt = "freiburg1_xyz-groundtruth.txt";
+  const char* fr1_es = "freiburg1_xyz-rgbdslam.txt";
+  const char* v1_gt = "V102_groundtruth.csv";
+  const char* v1_es = "V102.txt";
+  const Row rows[] = {
+      {fr2_gt, fr2_es, "none", false, false, 2174, 3.17399354190223, 2.9496938875994747,
+       2.594642464975095, 1.1719816438389132, 1.4603442833644174, 5.066735062280106},
+      {fr2_gt, fr2_es, "se3", false, false, 2174, 0.008118977562044912, 0.007491776870216138,
+       0.0074146298293169075, 0.0031290695070393085, 0.00034963619840676515, 0.024299593694384707},
+      {fr2_gt, fr2_es, "sim3", false, false, 2174, 0.006123163030157227, 0.005586197318706093,
+       0.005305225075852543, 0.0025074937707529996, 0.00018979580960878624, 0.02147678556278729},
+      {fr2_gt, fr2_es, "none", true, false, 2173, 0.0034903213747872895, 0.003038087417500965,
+       0.002750288386204, 0.0017182456584898887, 0.00013196900558788363, 0.019484678920167454},
+      {fr2_gt, fr2_es, "none", true, true, 2173, 0.28051922626732667, 0.22955611958091907,
+       0.1878184571190609, 0.16122972513953615, 0.006038945919658547, 1.2594035027080082},
+      {fr1_gt, fr1_es, "none", false, false, 785, 0.020079418378506592, 0.01806251843069654,
+       0.016517756173282164, 0.008770887660884508, 0.0012561023047507462, 0.04328943388403233},
+      {fr1_gt, fr1_es, "se3", false, false, 785, 0.013470088849733684, 0.012024498709110232,
+       0.011183186775061124, 0.006070809205890603, 0.0009550461813177855, 0.03475954589500919},
+      {fr1_gt, fr1_es, "sim3", false, false, 785, 0.013389384904168198, 0.011986889624888907,
+       0.011133899090810763, 0.005965744315062285, 0.0007327067052291716, 0.03484614485226124},
+      {fr1_gt, fr1_es, "none", true, false, 784, 0.005764370848928307, 0.004815609470203957,
+       0.004138857799364154, 0.0031682608343468867, 0.000171061153462197, 0.02086581453232984},
+      {fr1_gt, fr1_es, "none", true, true, 784, 0.3536131610447984, 0.3003065811400405,
+       0.262138999669449, 0.18670357518825084, 0.016937143523711472, 1.6332960623334383},
+      {v1_gt, v1_es, "none", false, false, 798, 2.5541740462181335, 2.5072878884642713,
+       2.377860678157887, 0.4871473111233262, 1.7521054261676152, 3.6551520318116726},
+      {v1_gt, v1_es, "se3", false, false, 798, 0.09172711520685754, 0.08152162194619848,
+       0.07791194901949505, 0.042048648247395584, 0.0026199870973830325, 0.2558167338139715},
+      {v1_gt, v1_es, "sim3", false, false, 798, 0.08384138804295287, 0.0748410847826337,
+       0.07194517866622582, 0.03779140613324193, 0.007000290579426618, 0.22665179238277222},
+      {v1_gt, v1_es, "none", true, false, 797, 0.015076710159641328, 0.006106922465380459,
+       0.004183939336058062, 0.013784508958960542, 0.00011469502653263614, 0.21740892442745757},
+      {v1_gt, v1_es, "none", true, true, 797, 0.3576155948859286, 0.08987560074843898,
+       0.03303003251207443, 0.34613767505968457, 0.003067746632942047, 4.939154960254689},
+  };
+  for (const Row& row : rows) {
+    SCOPED_TRACE(fmt::format("{} {} align {} {} {}", row.gt, row.est, row.align,
+                             row.rpe ? "RPE" : "APE", row.angle ? "angle_deg" : "trans"));
+    BenchOptions o;
+    o.gt = dir + "/" + row.gt;
+    o.est = dir + "/" + row.est;
+    o.convention = "evo";
+    o.align = row.align;
+    const PairRun run = score_pair(o);
+    const Stats& s = row.rpe ? (row.angle ? find_rpe(run.result, "delta")->rot_deg
+                                          : find_rpe(run.result, "delta")->trans)
+                             : (row.angle ? run.result.ate_rot_deg : run.result.ate_trans);
+    EXPECT_EQ(s.n, row.n);
+    for (auto [got, want] : {std::pair{s.rmse, row.rmse},
+                             {s.mean, row.mean},
+                             {s.median, row.median},
+                             {s.std, row.std},
+                             {s.max, row.max}}) {
+      EXPECT_LE(std::abs(got - want), 1e-9 * std::abs(want)) << got << " vs evo's " << want;
+    }
+    // evo's smallest errors are differences of nearly equal numbers: absolute agreement.
+    EXPECT_NEAR(s.min, row.min, 1e-12);
+  }
 }
 
 TEST(BenchPeers, KittiDevkitInDoubleMatchesToOneBillionth) {
