@@ -85,7 +85,16 @@ void add_bench(CLI::App& app) {
       "--duplicate-stamps", o->duplicates,
       "poses with equal stamps: error | drop (keep the first) | keep (default: keep for\n"
       "the evo and vbr conventions, as those tools do; error otherwise)");
-  cmd->add_option("--report", o->report, "folder for bench.json (every figure) and SVG plots");
+  cmd->add_option("--report", o->report,
+                  "folder for bench.json (every figure, a few kB) and the plots trajectory.svg,\n"
+                  "ate.svg, rpe.svg");
+  cmd->add_option("--plot-mode", o->plot_mode,
+                  "plane of the trajectory plot: auto (the two axes of largest spread) | xy | xz "
+                  "| yz")
+      ->capture_default_str();
+  cmd->add_flag("--per-pose", o->per_pose,
+                "with --report: also per_pose.csv (each matched pose: positions, ATE) and\n"
+                "segments_<kind>.csv (each RPE segment); large for long trajectories");
   cmd->add_option("--gt-dir", o->gt_dir, "leaderboard: folder of <seq>_gt.txt");
   cmd->add_option("--est-dir", o->est_dir, "leaderboard: folder of <method>/<seq>_es.txt");
   cmd->add_option("--methods", o->methods, "leaderboard: comma-separated method folders");

@@ -1,12 +1,15 @@
 #include "rigcal/bench/evaluate.h"
 
 #include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <cmath>
 
 #include "rigcal/core/error.h"
+#include "rigcal/core/memory.h"
 
 namespace rigcal::bench {
 namespace {
@@ -60,12 +63,14 @@ RpeResult make_rpe(std::string kind, std::string definition, std::vector<Segment
   r.definition = std::move(definition);
   r.drift = pooled_drift(segments);
   std::vector<double> t, a;
+  reserve_huge(t, segments.size());
+  reserve_huge(a, segments.size());
   for (const Segment& s : segments) {
     t.push_back(s.trans);
     a.push_back(s.rot_deg);
   }
-  r.trans = statistics(t);
-  r.rot_deg = statistics(a);
+  r.trans = statistics(std::move(t));
+  r.rot_deg = statistics(std::move(a));
   if (keep) r.segments = std::move(segments);
   return r;
 }
@@ -98,7 +103,8 @@ RpeResult stream_rpe(std::string kind, std::string definition, const std::vector
   r.definition = std::move(definition);
   std::vector<double> t, a;
   const size_t at_most = (gt.size() + step - 1) / step * lengths.size();
-  t.reserve(at_most), a.reserve(at_most);  // no reallocation spikes on millions of segments
+  reserve_huge(t, at_most);  // no reallocation spikes on millions of segments
+  reserve_huge(a, at_most);
   double t_rel = 0.0, r_rel = 0.0;
   for_each_length_segment(gt, est, lengths, step, [&](const Segment& s) {
     t.push_back(s.trans);
@@ -112,8 +118,8 @@ RpeResult stream_rpe(std::string kind, std::string definition, const std::vector
     r.drift.trans_pct = 100.0 * t_rel / static_cast<double>(t.size());
     r.drift.rot_deg_per_m = r_rel / static_cast<double>(t.size());
   }
-  r.trans = statistics(t);
-  r.rot_deg = statistics(a);
+  r.trans = statistics(std::move(t));
+  r.rot_deg = statistics(std::move(a));
   return r;
 }
 
@@ -123,19 +129,43 @@ struct VbrFigures {
   double rpe_trans_pct = 0, rpe_rot_deg_per_m = 0, ate_trans = 0, ate_rot = 0;
   size_t n_segments = 0;
   std::vector<size_t> matched;  // estimate index per GT pose
+  // The float matching against the same walk on the exact stamps: GT poses paired otherwise, and
+  // the largest stamp difference of a float pair (s).
+  size_t n_rematched = 0;
+  double worst_pair_dt_s = 0;
 };
 
+// The evaluator's walk: for each GT stamp, forward to the nearest estimate stamp (ties: later).
+template <class Stamp, class Diff>
+std::vector<size_t> vbr_walk(const std::vector<Stamp>& t_gt, const std::vector<Stamp>& t_est,
+                             Diff diff) {
+  std::vector<size_t> matched;
+  matched.reserve(t_gt.size());
+  size_t k = 0;
+  for (size_t i = 0; i < t_gt.size(); ++i) {
+    auto min_delta = diff(t_est[k], t_gt[i]);
+    while (k + 1 < t_est.size() && diff(t_est[k + 1], t_gt[i]) <= min_delta) {
+      min_delta = diff(t_est[k + 1], t_gt[i]);
+      ++k;
+    }
+    matched.push_back(k);
+  }
+  return matched;
+}
+
+// The evaluator reads each pose as float and builds its rotation from the float quaternion.
 Eigen::Isometry3f to_float(const SE3& T) {
   Eigen::Isometry3f out = Eigen::Isometry3f::Identity();
-  out.linear() = T.R.cast<float>();
+  out.linear() = Eigen::Quaternionf(Eigen::Quaterniond(T.R).cast<float>()).toRotationMatrix();
   out.translation() = T.t.cast<float>();
   return out;
 }
 
-float vbr_rotation_error_deg(const Eigen::Isometry3f& E) {
+// The angle in float, returned (and summed) in double, as the evaluator does.
+double vbr_rotation_error_deg(const Eigen::Isometry3f& E) {
   Eigen::Quaternionf q(E.linear());
   q.normalize();
-  const float rad = Eigen::Quaternionf(1.0f, 0.0f, 0.0f, 0.0f).angularDistance(q);
+  const double rad = Eigen::Quaternionf(1.0f, 0.0f, 0.0f, 0.0f).angularDistance(q);
   return rad * (180.0f / M_PI);
 }
 
@@ -144,29 +174,30 @@ VbrFigures vbr_evaluator(const Trajectory& gt, const Trajectory& est) {
   std::vector<float> t_gt(gt.size()), t_est(est.size());
   for (size_t i = 0; i < gt.size(); ++i) t_gt[i] = static_cast<float>(gt.stamps[i].seconds());
   for (size_t i = 0; i < est.size(); ++i) t_est[i] = static_cast<float>(est.stamps[i].seconds());
-  // Nearest estimate stamp per GT pose, walking forward, no threshold.
-  size_t k = 0;
+  // Nearest estimate stamp per GT pose, walking forward, no threshold; in float as the evaluator
+  // reads its stamps, and again on the exact stamps to tell what float costs.
+  f.matched = vbr_walk(t_gt, t_est, [](float a, float b) { return std::abs(a - b); });
+  const std::vector<size_t> exact = vbr_walk(
+      gt.stamps, est.stamps, [](Time a, Time b) { return a < b ? (b - a).ns : (a - b).ns; });
   for (size_t i = 0; i < gt.size(); ++i) {
-    float min_delta = std::abs(t_est[k] - t_gt[i]);
-    while (k + 1 < est.size() && std::abs(t_est[k + 1] - t_gt[i]) <= min_delta) {
-      min_delta = std::abs(t_est[k + 1] - t_gt[i]);
-      ++k;
-    }
-    f.matched.push_back(k);
+    const double dt = std::abs((est.stamps[f.matched[i]] - gt.stamps[i]).seconds());
+    f.worst_pair_dt_s = std::max(f.worst_pair_dt_s, dt);
+    if (f.matched[i] != exact[i]) ++f.n_rematched;
   }
   std::vector<Eigen::Isometry3f> P_gt(gt.size()), P_es(gt.size());
   for (size_t i = 0; i < gt.size(); ++i) {
     P_gt[i] = to_float(gt.T_world_body[i]);
     P_es[i] = to_float(est.T_world_body[f.matched[i]]);
   }
-  // RPE over fractions of the GT length, every frame a start, float sums.
+  // RPE over fractions of the GT length, every frame a start: poses and segments in float, the
+  // sums in double (a float sum of millions of segments drifts: 1.7 % at 1M poses).
   std::vector<float> dist(gt.size(), 0.0f);
   for (size_t i = 1; i < gt.size(); ++i) {
     dist[i] = dist[i - 1] + (P_gt[i - 1].translation() - P_gt[i].translation()).norm();
   }
   std::vector<float> lengths;
   for (double p : kVbrFractions) lengths.push_back(dist.back() * static_cast<float>(p));
-  float t_sum = 0.0f, r_sum = 0.0f;
+  double t_sum = 0.0, r_sum = 0.0;
   size_t n = 0;
   for (size_t first = 0; first < gt.size(); ++first) {
     for (float len : lengths) {
@@ -177,13 +208,13 @@ VbrFigures vbr_evaluator(const Trajectory& gt, const Trajectory& est) {
       const Eigen::Isometry3f d_es = P_es[first].inverse() * P_es[last];
       const Eigen::Isometry3f E = d_es.inverse() * d_gt;
       r_sum += vbr_rotation_error_deg(E) / len;
-      t_sum += E.translation().norm() / len;
+      t_sum += static_cast<double>(E.translation().norm()) / len;
       ++n;
     }
   }
   f.n_segments = n;
-  f.rpe_rot_deg_per_m = r_sum / static_cast<float>(n);
-  f.rpe_trans_pct = 100 * t_sum / static_cast<float>(n);
+  f.rpe_rot_deg_per_m = r_sum / static_cast<double>(n);
+  f.rpe_trans_pct = 100 * t_sum / static_cast<double>(n);
   // ATE: float Umeyama SE(3) of the matched estimate onto the GT, then sqrt(mean |e|).
   Eigen::Matrix<float, 3, Eigen::Dynamic> X(3, gt.size()), Y(3, gt.size());
   for (size_t i = 0; i < gt.size(); ++i) {
@@ -193,14 +224,14 @@ VbrFigures vbr_evaluator(const Trajectory& gt, const Trajectory& est) {
   const Eigen::Matrix4f A = Eigen::umeyama(X, Y, false);
   Eigen::Isometry3f T_align(A.block<3, 3>(0, 0));
   T_align.translation() = A.block<3, 1>(0, 3);
-  float at = 0.0f, ar = 0.0f;
+  double at = 0.0, ar = 0.0;
   for (size_t i = 0; i < gt.size(); ++i) {
     const Eigen::Isometry3f E = P_gt[i].inverse() * (T_align * P_es[i]);
     ar += vbr_rotation_error_deg(E);
     at += E.translation().norm();
   }
-  f.ate_trans = std::sqrt(at / static_cast<float>(gt.size()));
-  f.ate_rot = std::sqrt(ar / static_cast<float>(gt.size()));
+  f.ate_trans = std::sqrt(at / static_cast<double>(gt.size()));
+  f.ate_rot = std::sqrt(ar / static_cast<double>(gt.size()));
   return f;
 }
 
@@ -265,6 +296,7 @@ EvalResult evaluate(Trajectory gt, Trajectory est, const EvalOptions& opt) {
   res.n_gt = gt.size();
   res.n_est = est.size();
   res.association = opt.association.value_or(default_association(opt.convention, gt, est));
+  res.has_stamps = gt.has_stamps && est.has_stamps;
   const Alignment alignment = opt.alignment.value_or(default_alignment(opt.convention));
   if (res.association != Association::index && (!gt.has_stamps || !est.has_stamps)) {
     throw Error(
@@ -284,6 +316,30 @@ EvalResult evaluate(Trajectory gt, Trajectory est, const EvalOptions& opt) {
     if (!gt.has_stamps || !est.has_stamps)
       throw Error("the vbr convention needs stamped trajectories");
     vbr = vbr_evaluator(gt, est);
+    // Stamps since the UNIX epoch (1.7e9 s) are 128 s apart in float: the evaluator pairs nearly
+    // every pose with the wrong one and its figures mean nothing.
+    const double t_max =
+        std::max(std::abs(gt.stamps.back().seconds()), std::abs(gt.stamps.front().seconds()));
+    const float f_max = static_cast<float>(t_max);
+    const double spacing = std::nextafter(f_max, INFINITY) - f_max;
+    const double interval =
+        gt.size() > 1 ? (gt.stamps.back() - gt.stamps.front()).seconds() / double(gt.size() - 1)
+                      : 0.0;
+    if (vbr->n_rematched > 0 && spacing >= 0.5 * interval) {
+      throw Error(fmt::format(
+          "the VBR evaluator reads stamps as float: near {:.0f} s floats are {:g} s apart, over "
+          "half the ground truth's {:.3g} s between poses, and it pairs {} of {} ground-truth "
+          "poses with another estimate pose than the nearest (up to {:.3g} s away). Its figures "
+          "on these stamps mean nothing: subtract the first stamp from both files, or use "
+          "--convention rigcal",
+          t_max, spacing, interval, vbr->n_rematched, gt.size(), vbr->worst_pair_dt_s));
+    }
+    if (vbr->n_rematched > 0) {
+      res.notes.push_back(fmt::format(
+          "warning: the evaluator's float stamps pair {} of {} ground-truth poses with another "
+          "estimate pose than the nearest (up to {:.3g} s away); its figures carry that",
+          vbr->n_rematched, gt.size(), vbr->worst_pair_dt_s));
+    }
   }
 
   // Matched poses. The inputs are released once matched: 1e6 poses are ~100 MB a copy.
@@ -292,8 +348,8 @@ EvalResult evaluate(Trajectory gt, Trajectory est, const EvalOptions& opt) {
   if (res.association == Association::interpolate) {
     Interpolated in = interpolate_gt(gt, est, opt.max_gap);
     m_gt = std::move(in.T_world_gt);
-    m_est.reserve(in.est.size());
-    m_stamps.reserve(in.est.size());
+    reserve_huge(m_est, in.est.size());
+    reserve_huge(m_stamps, in.est.size());
     for (size_t i : in.est) {
       m_est.push_back(est.T_world_body[i]);
       m_stamps.push_back(est.stamps[i]);
@@ -342,10 +398,10 @@ EvalResult evaluate(Trajectory gt, Trajectory est, const EvalOptions& opt) {
           fmt::format("one-to-one pairs within {} s, closest first", opt.max_diff.seconds()));
     }
     // One side at a time, releasing each input once copied: the peak holds one copy less.
-    m_gt.reserve(m.gt.size()), m_stamps.reserve(m.gt.size());
+    reserve_huge(m_gt, m.gt.size()), reserve_huge(m_stamps, m.gt.size());
     for (size_t k : m.gt) m_gt.push_back(gt.T_world_body[k]), m_stamps.push_back(gt.stamps[k]);
     gt = Trajectory{};
-    m_est.reserve(m.est.size());
+    reserve_huge(m_est, m.est.size());
     for (size_t k : m.est) m_est.push_back(est.T_world_body[k]);
   }
   gt = Trajectory{};
@@ -358,9 +414,16 @@ EvalResult evaluate(Trajectory gt, Trajectory est, const EvalOptions& opt) {
                     overlap, to_string(res.association)));
   }
   // rigcal re-orthonormalises rotations read with few digits; the peers use them as read.
+  // (A quaternion's matrix is orthonormal to rounding already: only the others take the SVD.)
   if (opt.convention == Convention::rigcal) {
-    for (SE3& T : m_gt) T.R = nearest_rotation(T.R);
-    for (SE3& T : m_est) T.R = nearest_rotation(T.R);
+    for (std::vector<SE3>* poses : {&m_gt, &m_est}) {
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, poses->size(), 4096), [&](const auto& r) {
+        for (size_t i = r.begin(); i < r.end(); ++i) {
+          Eigen::Matrix3d& R = (*poses)[i].R;
+          if (orthonormality_error(R) > 1e-13) R = nearest_rotation(R);
+        }
+      });
+    }
   }
 
   res.alignment = align(m_gt, m_est, alignment, opt.align_first_n);
@@ -368,11 +431,13 @@ EvalResult evaluate(Trajectory gt, Trajectory est, const EvalOptions& opt) {
 
   PoseErrors ate = absolute_errors(m_gt, m_est);
   res.ate_trans = statistics(ate.trans);
-  res.ate_rot_deg = statistics(ate.rot_deg);
+  res.ate_rot_deg = statistics(opt.keep_per_pose ? ate.rot_deg : std::move(ate.rot_deg));
   res.gt_length = cumulative_distances(m_gt).back();
-  if (opt.keep_segments) {
+  if (opt.keep_per_pose) {
     res.stamps = std::move(m_stamps);
     res.ate_trans_errors = std::move(ate.trans);
+    res.ate_rot_errors_deg = std::move(ate.rot_deg);
+    reserve_huge(res.p_gt, m_gt.size()), reserve_huge(res.p_est_aligned, m_gt.size());
     for (size_t i = 0; i < m_gt.size(); ++i) {
       res.p_gt.push_back(m_gt[i].t);
       res.p_est_aligned.push_back(m_est[i].t);
@@ -394,14 +459,16 @@ EvalResult evaluate(Trajectory gt, Trajectory est, const EvalOptions& opt) {
           "VBR: segments of 1, 2, 3, 5, 8, 13, 21, 34, 55 % of the GT length, every frame a start",
           m_gt, m_est, lengths, 1, keep));
       res.rpe.push_back(make_rpe("delta", delta_definition(opt),
-                                 delta_errors(m_gt, m_est, delta_pairs(m_est, opt)), keep));
+                                 delta_errors(m_gt, m_est, delta_pairs(m_est, opt)),
+                                 keep || opt.keep_per_pose));
       res.notes.push_back(
           "rigcal: rotations re-orthonormalised; ATE is the true RMSE; RPE pooled over segments");
       break;
     }
     case Convention::evo:
       res.rpe.push_back(make_rpe("delta", "evo_rpe: " + delta_definition(opt) + ", E = inv(dQ) dP",
-                                 delta_errors(m_gt, m_est, delta_pairs(m_est, opt)), keep));
+                                 delta_errors(m_gt, m_est, delta_pairs(m_est, opt)),
+                                 keep || opt.keep_per_pose));
       res.notes.push_back(
           "evo: APE and RPE as evo_ape / evo_rpe compute them; rotation angles from the log map");
       break;

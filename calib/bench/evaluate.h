@@ -36,7 +36,11 @@ struct EvalOptions {
   double delta = 1;                           // evo-style RPE delta ...
   DeltaUnit delta_unit = DeltaUnit::frames;   // ... in frames or metres
   bool all_pairs = false;                     // evo's --all_pairs
-  bool keep_segments = false;                 // keep per-segment rows (plots, reports)
+  // Per matched pose (stamps, positions, ATE errors) and the delta kind's pairs: the report's
+  // plots, a few tens of MB for a million poses.
+  bool keep_per_pose = false;
+  // Every RPE kind's segment rows (--per-pose): VBR's every-frame starts give 9 a pose.
+  bool keep_segments = false;
   // evo compares the float64 seconds it reads: decimal seconds, or integer nanoseconds (EuRoC)
   // read as a float64 and divided by 1e9. True when the file gave nanoseconds.
   bool gt_stamps_ns = false, est_stamps_ns = false;
@@ -47,7 +51,7 @@ struct RpeResult {
   std::string definition;         // in words
   Drift drift;                    // pooled trans/length (%) and rot/length (deg/m)
   Stats trans, rot_deg;           // of the raw segment errors (m, deg)
-  std::vector<Segment> segments;  // with keep_segments
+  std::vector<Segment> segments;  // with keep_segments (the delta kind's: keep_per_pose)
 };
 
 struct EvalResult {
@@ -61,16 +65,18 @@ struct EvalResult {
   std::optional<double> vbr_ate_trans, vbr_ate_rot;
   std::vector<RpeResult> rpe;
   std::vector<std::string> notes;  // what was computed, in words
-  // Per matched pose, with keep_segments: stamps, GT and aligned estimate positions, ATE errors.
+  // Per matched pose, with keep_per_pose: stamps, GT and aligned estimate positions, ATE errors.
+  // has_stamps: false when paired by index without stamps (the stamps are then pose indices).
+  bool has_stamps = true;
   std::vector<Time> stamps;
   std::vector<Eigen::Vector3d> p_gt, p_est_aligned;
-  std::vector<double> ate_trans_errors;
+  std::vector<double> ate_trans_errors, ate_rot_errors_deg;
 };
 
 // Throws rigcal::Error when the two do not overlap (no matched pairs) or alignment is degenerate.
 // Takes the trajectories by value: move them in to keep the peak memory of long ones low.
-// Per-pose data for plots (stamps, positions, ATE errors) and segments are kept only with
-// options.keep_segments.
+// Per-pose data for plots (stamps, positions, ATE errors) is kept only with
+// options.keep_per_pose, segments only with options.keep_segments.
 EvalResult evaluate(Trajectory gt, Trajectory est, const EvalOptions& options = {});
 
 const RpeResult* find_rpe(const EvalResult& result, std::string_view kind);

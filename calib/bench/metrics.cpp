@@ -1,6 +1,8 @@
 #include "rigcal/bench/metrics.h"
 
 #include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <Eigen/SVD>
 #include <algorithm>
@@ -9,11 +11,12 @@
 #include <numeric>
 
 #include "rigcal/core/error.h"
+#include "rigcal/core/memory.h"
 #include "rigcal/core/stats.h"
 
 namespace rigcal::bench {
 
-Stats statistics(const std::vector<double>& values) {
+Stats statistics(std::vector<double> values) {
   Stats s;
   s.n = values.size();
   if (values.empty()) return s;
@@ -32,7 +35,7 @@ Stats statistics(const std::vector<double>& values) {
   double var = 0.0;
   for (double v : values) var += (v - s.mean) * (v - s.mean);
   s.std = std::sqrt(var / n);
-  s.median = median_midpoint(values);
+  s.median = median_midpoint(std::move(values));
   return s;
 }
 
@@ -166,6 +169,8 @@ Matches associate_by_index(const Trajectory& gt, const Trajectory& est) {
 
 Interpolated interpolate_gt(const Trajectory& gt, const Trajectory& est, Time max_gap) {
   Interpolated out;
+  reserve_huge(out.est, est.size());
+  reserve_huge(out.T_world_gt, est.size());
   size_t j = 0;  // first GT stamp >= the estimate stamp
   for (size_t i = 0; i < est.size(); ++i) {
     const Time t = est.stamps[i];
@@ -275,6 +280,8 @@ SE3 apply(const AlignmentResult& alignment, const SE3& T_world_est) {
 PoseErrors absolute_errors(const std::vector<SE3>& T_world_gt,
                            const std::vector<SE3>& T_world_est) {
   PoseErrors e;
+  reserve_huge(e.trans, T_world_gt.size());
+  reserve_huge(e.rot_deg, T_world_gt.size());
   e.trans.resize(T_world_gt.size());
   e.rot_deg.resize(T_world_gt.size());
   for (size_t i = 0; i < T_world_gt.size(); ++i) {
@@ -285,34 +292,56 @@ PoseErrors absolute_errors(const std::vector<SE3>& T_world_gt,
 }
 
 std::vector<double> cumulative_distances(const std::vector<SE3>& T_world_body) {
-  std::vector<double> dist(T_world_body.size(), 0.0);
+  std::vector<double> dist;
+  reserve_huge(dist, T_world_body.size());
+  dist.resize(T_world_body.size(), 0.0);
   for (size_t i = 1; i < T_world_body.size(); ++i) {
     dist[i] = dist[i - 1] + (T_world_body[i].t - T_world_body[i - 1].t).norm();
   }
   return dist;
 }
 
-namespace {
-Segment relative_error(const std::vector<SE3>& gt, const std::vector<SE3>& est, size_t i, size_t j,
-                       double length) {
-  const SE3 dP_gt = gt[i].inverse() * gt[j];
-  const SE3 dP_est = est[i].inverse() * est[j];
-  const SE3 E = dP_est.inverse() * dP_gt;
-  return {i, j, length, E.t.norm(), rotation_angle(E.R) * (180.0 / M_PI)};
-}
-}  // namespace
-
 void for_each_length_segment(const std::vector<SE3>& T_world_gt,
                              const std::vector<SE3>& T_world_est,
                              const std::vector<double>& lengths, size_t step,
                              const std::function<void(const Segment&)>& visit) {
   const std::vector<double> dist = cumulative_distances(T_world_gt);
-  for (size_t first = 0; first < dist.size(); first += step) {
-    for (double len : lengths) {
-      // The first pose farther than `len` along the GT path (the KITTI devkit's rule).
-      const auto it = std::upper_bound(dist.begin() + first, dist.end(), dist[first] + len);
-      if (it == dist.end()) continue;
-      visit(relative_error(T_world_gt, T_world_est, first, it - dist.begin(), len));
+  const size_t n_starts = (dist.size() + step - 1) / step, n_len = lengths.size();
+  // Starts in blocks computed in parallel, then visited in order: the same sequence as one
+  // thread gives, in bounded memory (millions of segments for every-frame starts).
+  constexpr size_t kBlock = 8192;
+  std::vector<Segment> slots(std::min(n_starts, kBlock) * n_len);
+  std::vector<char> found(slots.size());
+  for (size_t b0 = 0; b0 < n_starts; b0 += kBlock) {
+    const size_t b1 = std::min(n_starts, b0 + kBlock);
+    tbb::parallel_for(tbb::blocked_range<size_t>(b0, b1, 256), [&](const auto& range) {
+      for (size_t s = range.begin(); s < range.end(); ++s) {
+        const size_t first = s * step;
+        const SE3& gi = T_world_gt[first];
+        const SE3& ei = T_world_est[first];
+        // E = inv(dP_est) dP_gt: |t(E)| = |t(dP_gt) - t(dP_est)| (a rotation keeps lengths), and
+        // R(E) = R_ej' A R_gj with A = R_ei R_gi', similar to A R_gj R_ej': the same angle.
+        const Eigen::Matrix3d A = ei.R * gi.R.transpose();
+        for (size_t k = 0; k < n_len; ++k) {
+          const size_t slot = (s - b0) * n_len + k;
+          // The first pose farther than the length along the GT path (the KITTI devkit's rule).
+          const auto it = std::upper_bound(dist.begin() + static_cast<std::ptrdiff_t>(first),
+                                           dist.end(), dist[first] + lengths[k]);
+          found[slot] = it != dist.end();
+          if (!found[slot]) continue;
+          const size_t last = static_cast<size_t>(it - dist.begin());
+          const SE3& gj = T_world_gt[last];
+          const SE3& ej = T_world_est[last];
+          const Eigen::Vector3d d_gt = gi.R.transpose() * (gj.t - gi.t);
+          const Eigen::Vector3d d_est = ei.R.transpose() * (ej.t - ei.t);
+          const Eigen::Matrix3d M = A * gj.R * ej.R.transpose();
+          slots[slot] = {first, last, lengths[k], (d_gt - d_est).norm(),
+                         rotation_angle(M) * (180.0 / M_PI)};
+        }
+      }
+    });
+    for (size_t slot = 0; slot < (b1 - b0) * n_len; ++slot) {
+      if (found[slot]) visit(slots[slot]);
     }
   }
 }
@@ -389,7 +418,7 @@ std::vector<Segment> delta_errors(const std::vector<SE3>& T_world_gt,
                                   const std::vector<SE3>& T_world_est,
                                   const std::vector<std::pair<size_t, size_t>>& pairs) {
   std::vector<Segment> segments;
-  segments.reserve(pairs.size());
+  reserve_huge(segments, pairs.size());
   const std::vector<double> dist = cumulative_distances(T_world_gt);
   for (const auto& [i, j] : pairs) {
     const SE3 dQ = T_world_gt[i].inverse() * T_world_gt[j];

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "rigcal/core/error.h"
+#include "rigcal/core/time.h"
 #include "rigcal/core/version.h"
 #include "rigcal/io/files.h"
 #include "rigcal/report/json.h"
@@ -27,6 +28,39 @@ nlohmann::json number_or_null(bool ok, double v) {
 }
 
 }  // namespace
+
+PlotMode plot_mode_from_string(std::string_view name) {
+  for (PlotMode m : {PlotMode::automatic, PlotMode::xy, PlotMode::xz, PlotMode::yz}) {
+    if (name == to_string(m)) return m;
+  }
+  throw Error(fmt::format("--plot-mode: expected auto, xy, xz or yz, got '{}'", name));
+}
+
+std::string_view to_string(PlotMode mode) {
+  switch (mode) {
+    case PlotMode::automatic:
+      return "auto";
+    case PlotMode::xy:
+      return "xy";
+    case PlotMode::xz:
+      return "xz";
+    case PlotMode::yz:
+      return "yz";
+  }
+  return "?";
+}
+
+PlotMode dominant_plane(const std::vector<Eigen::Vector3d>& positions) {
+  if (positions.empty()) return PlotMode::xy;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero(), var = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : positions) mean += p;
+  mean /= static_cast<double>(positions.size());
+  for (const Eigen::Vector3d& p : positions) var += (p - mean).cwiseAbs2();
+  // Leave out the axis of least spread.
+  Eigen::Index least = 0;
+  var.minCoeff(&least);
+  return least == 0 ? PlotMode::yz : least == 1 ? PlotMode::xz : PlotMode::xy;
+}
 
 nlohmann::json bench_json(const EvalResult& r, const std::map<std::string, std::string>& inputs) {
   nlohmann::json j;
@@ -64,44 +98,141 @@ nlohmann::json bench_json(const EvalResult& r, const std::map<std::string, std::
       k["trans"] = stats_json(rpe.trans);
       k["rot"] = stats_json(rpe.rot_deg);
     }
-    if (!rpe.segments.empty()) {
-      nlohmann::json segs = nlohmann::json::array();
-      for (const Segment& s : rpe.segments) {
-        segs.push_back({s.first, s.last, s.length, s.trans, s.rot_deg});
-      }
-      k["segments"] = {{"columns", {"first", "last", "length_m", "trans_m", "rot_deg"}},
-                       {"rows", segs}};
-    }
     j["rpe"][rpe.kind] = k;
   }
   j["notes"] = r.notes;
   return j;
 }
 
+namespace {
+
+// The positions' two coordinates in the plot's plane.
+std::pair<int, int> plane_axes(PlotMode mode) {
+  switch (mode) {
+    case PlotMode::xz:
+      return {0, 2};
+    case PlotMode::yz:
+      return {1, 2};
+    default:
+      return {0, 1};
+  }
+}
+
+// Horizontal lines at a statistic's rmse, mean, median and mean +- std (evo's error plots).
+void add_statistics_lines(report::Plot& plot, const Stats& s, double x0, double x1,
+                          std::string_view unit) {
+  auto line = [&](std::string label, double y) {
+    plot.series.push_back({std::move(label), {x0, x1}, {y, y}, {}});
+  };
+  line(fmt::format("rmse {:.4g} {}", s.rmse, unit), s.rmse);
+  line(fmt::format("mean {:.4g} {}", s.mean, unit), s.mean);
+  line(fmt::format("median {:.4g} {}", s.median, unit), s.median);
+  line(fmt::format("mean - std ({:.4g} {})", s.std, unit), s.mean - s.std);
+  line(fmt::format("mean + std ({:.4g} {})", s.std, unit), s.mean + s.std);
+}
+
+std::string per_pose_csv(const EvalResult& r) {
+  fmt::memory_buffer out;
+  fmt::format_to(std::back_inserter(out),
+                 "{},gt_x,gt_y,gt_z,est_x,est_y,est_z,ate_trans_m,ate_rot_deg\n",
+                 r.has_stamps ? "stamp_s" : "index");
+  for (size_t i = 0; i < r.p_gt.size(); ++i) {
+    const Eigen::Vector3d& g = r.p_gt[i];
+    const Eigen::Vector3d& e = r.p_est_aligned[i];
+    if (r.has_stamps) {
+      fmt::format_to(std::back_inserter(out), "{},", to_seconds_text(r.stamps[i]));
+    } else {
+      fmt::format_to(std::back_inserter(out), "{},", i);
+    }
+    fmt::format_to(std::back_inserter(out), "{},{},{},{},{},{},{},{}\n", g.x(), g.y(), g.z(), e.x(),
+                   e.y(), e.z(), r.ate_trans_errors[i], r.ate_rot_errors_deg[i]);
+  }
+  return fmt::to_string(out);
+}
+
+std::string segments_csv(const RpeResult& rpe) {
+  fmt::memory_buffer out;
+  fmt::format_to(std::back_inserter(out), "first,last,length_m,trans_m,rot_deg\n");
+  for (const Segment& s : rpe.segments) {
+    fmt::format_to(std::back_inserter(out), "{},{},{},{},{}\n", s.first, s.last, s.length, s.trans,
+                   s.rot_deg);
+  }
+  return fmt::to_string(out);
+}
+
+}  // namespace
+
 void write_bench_report(const EvalResult& r, const fs::path& dir,
-                        const std::map<std::string, std::string>& inputs) {
+                        const std::map<std::string, std::string>& inputs,
+                        const ReportOptions& options) {
+  const PlotMode mode =
+      options.plot_mode == PlotMode::automatic ? dominant_plane(r.p_gt) : options.plot_mode;
+  const auto [a, b] = plane_axes(mode);
+  const char* axis_names = "xyz";
   report::Plot top;
-  top.title = "Trajectories, top view (estimate coloured by ATE)";
-  top.x_label = "x [m]";
-  top.y_label = "y [m]";
+  top.title =
+      fmt::format("Trajectories in the {} plane (estimate coloured by ATE)", to_string(mode));
+  top.x_label = fmt::format("{} [m]", axis_names[a]);
+  top.y_label = fmt::format("{} [m]", axis_names[b]);
   top.value_label = "ATE [m]";
   top.equal_axes = true;
   report::PlotSeries gt{"ground truth", {}, {}, {}}, est{"estimate", {}, {}, r.ate_trans_errors};
   for (size_t i = 0; i < r.p_gt.size(); ++i) {
-    gt.x.push_back(r.p_gt[i].x()), gt.y.push_back(r.p_gt[i].y());
-    est.x.push_back(r.p_est_aligned[i].x()), est.y.push_back(r.p_est_aligned[i].y());
+    gt.x.push_back(r.p_gt[i][a]), gt.y.push_back(r.p_gt[i][b]);
+    est.x.push_back(r.p_est_aligned[i][a]), est.y.push_back(r.p_est_aligned[i][b]);
   }
-  top.series = {gt, est};
-  report::Plot along;
-  along.title = "ATE along the trajectory";
-  along.x_label = "time since the first pair [s]";
-  along.y_label = "translation error [m]";
+  top.series = {std::move(gt), std::move(est)};
+
+  // Time since the first pair, or the pose index for files without stamps.
+  auto along_x = [&](size_t i) {
+    return r.has_stamps ? (r.stamps[i] - r.stamps.front()).seconds() : static_cast<double>(i);
+  };
+  const std::string x_label = r.has_stamps ? "time since the first pair [s]" : "pose index";
+  report::Plot ate;
+  ate.title = "ATE along the trajectory (translation)";
+  ate.x_label = x_label;
+  ate.y_label = "translation error [m]";
   report::PlotSeries e{"ATE", {}, r.ate_trans_errors, {}};
-  for (const Time& t : r.stamps) e.x.push_back((t - r.stamps.front()).seconds());
-  along.series = {e};
-  io::write_files_atomic({{dir / "bench.json", report::json_text(bench_json(r, inputs))},
-                          {dir / "trajectory_top.svg", report::render_svg(top)},
-                          {dir / "ate_along.svg", report::render_svg(along)}});
+  e.x.reserve(r.stamps.size());
+  for (size_t i = 0; i < r.stamps.size(); ++i) e.x.push_back(along_x(i));
+  const double x_end = e.x.empty() ? 1.0 : e.x.back();
+  ate.series = {std::move(e)};
+  add_statistics_lines(ate, r.ate_trans, 0.0, x_end, "m");
+
+  report::Plot rpe_plot;
+  const RpeResult* delta = find_rpe(r, "delta");
+  rpe_plot.title = delta ? fmt::format("RPE, {} (translation)", delta->definition) : "RPE";
+  rpe_plot.x_label = x_label + " (the pair's first pose)";
+  rpe_plot.y_label = "translation error [m]";
+  if (delta && !delta->segments.empty()) {
+    report::PlotSeries d{"RPE", {}, {}, {}};
+    d.x.reserve(delta->segments.size()), d.y.reserve(delta->segments.size());
+    for (const Segment& s : delta->segments)
+      d.x.push_back(along_x(s.first)), d.y.push_back(s.trans);
+    rpe_plot.series = {std::move(d)};
+    add_statistics_lines(rpe_plot, delta->trans, 0.0, x_end, "m");
+  }
+
+  nlohmann::json summary = bench_json(r, inputs);
+  summary["plots"] = {{"plane", to_string(mode)},
+                      {"along", r.has_stamps ? "time" : "pose index"},
+                      {"files", {"trajectory.svg", "ate.svg", "rpe.svg"}}};
+  std::vector<io::OutputFile> files;
+  if (options.per_pose) {
+    std::vector<std::string> names = {"per_pose.csv"};
+    files.push_back({dir / "per_pose.csv", per_pose_csv(r)});
+    for (const RpeResult& k : r.rpe) {
+      if (k.segments.empty()) continue;
+      names.push_back("segments_" + k.kind + ".csv");
+      files.push_back({dir / names.back(), segments_csv(k)});
+    }
+    summary["per_pose_files"] = names;
+  }
+  files.push_back({dir / "bench.json", report::json_text(summary)});
+  files.push_back({dir / "trajectory.svg", report::render_svg(top)});
+  files.push_back({dir / "ate.svg", report::render_svg(ate)});
+  files.push_back({dir / "rpe.svg", report::render_svg(rpe_plot)});
+  io::write_files_atomic(files);
 }
 
 LeaderboardInput load_leaderboard_input(const fs::path& gt_dir, const fs::path& est_dir,

@@ -22,6 +22,8 @@ struct BenchOptions {
   bool all_pairs = false;
   double max_diff = 0.01, max_gap = 0.5;
   std::string duplicates;
+  std::string plot_mode = "auto";  // --plot-mode
+  bool per_pose = false;           // --per-pose: the rows as CSV beside bench.json
   // Leaderboard.
   std::string gt_dir, est_dir, methods;
   double ate_max = 10.0, rpe_max = 10.0;

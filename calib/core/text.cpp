@@ -10,18 +10,34 @@
 
 namespace rigcal {
 
-std::vector<std::string_view> split_fields(std::string_view line) {
+namespace {
+template <class Visit>
+void for_each_field(std::string_view line, Visit visit) {
   if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-  std::vector<std::string_view> out;
   size_t i = 0;
   auto is_sep = [](char c) { return c == ' ' || c == '\t' || c == ','; };
   while (i < line.size()) {
     while (i < line.size() && is_sep(line[i])) ++i;
     const size_t start = i;
     while (i < line.size() && !is_sep(line[i])) ++i;
-    if (i > start) out.push_back(line.substr(start, i - start));
+    if (i > start) visit(line.substr(start, i - start));
   }
+}
+}  // namespace
+
+std::vector<std::string_view> split_fields(std::string_view line) {
+  std::vector<std::string_view> out;
+  for_each_field(line, [&](std::string_view f) { out.push_back(f); });
   return out;
+}
+
+size_t split_fields(std::string_view line, std::span<std::string_view> out) {
+  size_t n = 0;
+  for_each_field(line, [&](std::string_view f) {
+    if (n < out.size()) out[n] = f;
+    ++n;
+  });
+  return n;
 }
 
 std::string_view trim(std::string_view s) {

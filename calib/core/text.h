@@ -1,6 +1,7 @@
 #pragma once
 // Small text helpers shared by every reader and writer: strict number parsing and the
 // shortest number text that reads back to the same double.
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -9,6 +10,9 @@ namespace rigcal {
 
 // Splits on runs of spaces, tabs and commas; drops empty fields and a trailing '\r'.
 std::vector<std::string_view> split_fields(std::string_view line);
+// The same into `out`, without allocating: returns the number of fields, of which the first
+// out.size() are stored (millions of lines of a trajectory).
+size_t split_fields(std::string_view line, std::span<std::string_view> out);
 
 // Whole-string, finite double (no NaN or infinity). Throws rigcal::Error naming `what`.
 double parse_double(std::string_view text, std::string_view what);

@@ -17,7 +17,9 @@ namespace rigcal::io {
 
 namespace fs = std::filesystem;
 
-std::string read_text_file(const fs::path& path, size_t max_bytes) {
+namespace {
+
+void refuse_non_files(const fs::path& path) {
   std::error_code ec;
   if (fs::is_directory(path, ec)) {
     throw Error(fmt::format("{}: is a folder, expected a file", path.string()));
@@ -27,6 +29,49 @@ std::string read_text_file(const fs::path& path, size_t max_bytes) {
       t == fs::file_type::fifo || t == fs::file_type::socket) {
     throw Error(fmt::format("{}: a pipe or socket, expected a file", path.string()));
   }
+}
+
+}  // namespace
+
+void read_text_blocks(const fs::path& path,
+                      const std::function<void(std::string_view block)>& visit,
+                      size_t block_bytes) {
+  refuse_non_files(path);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw Error(fmt::format("{}: cannot open: {}", path.string(), std::strerror(errno)));
+  }
+  // One buffer reused: the lines cut at a block's end move to its front before the next read.
+  std::string buffer(block_bytes + 1, '\0');
+  size_t kept = 0;
+  while (true) {
+    in.read(buffer.data() + kept, static_cast<std::streamsize>(buffer.size() - kept));
+    if (in.bad()) throw Error(fmt::format("{}: read error", path.string()));
+    const size_t filled = kept + static_cast<size_t>(in.gcount());
+    const bool end = in.eof() || in.gcount() == 0;
+    const std::string_view data(buffer.data(), filled);
+    size_t cut = end ? filled : data.rfind('\n');
+    if (cut == std::string_view::npos) {  // a line longer than the buffer: grow it
+      buffer.resize(buffer.size() * 2);
+      kept = filled;
+      continue;
+    }
+    if (!end) ++cut;  // the block keeps its last '\n'
+    visit(data.substr(0, cut));
+    if (end) return;
+    kept = filled - cut;
+    std::memmove(buffer.data(), buffer.data() + cut, kept);
+  }
+}
+
+size_t file_size_or_zero(const fs::path& path) {
+  std::error_code ec;
+  const auto size = fs::file_size(path, ec);
+  return ec ? 0 : static_cast<size_t>(size);
+}
+
+std::string read_text_file(const fs::path& path, size_t max_bytes) {
+  refuse_non_files(path);
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) {
     throw Error(fmt::format("{}: cannot open: {}", path.string(), std::strerror(errno)));

@@ -4,7 +4,9 @@
 // and renamed only when all of them were written, so a failed run leaves no half-written output.
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -13,6 +15,14 @@ namespace rigcal::io {
 // Throws rigcal::Error naming the path when the file cannot be read, or when it is larger than
 // `max_bytes` (a documented limit of the format being read: kMaxYamlBytes for YAML).
 std::string read_text_file(const std::filesystem::path& path, size_t max_bytes = SIZE_MAX);
+
+// The file in blocks of about `block_bytes`, each ending at a line end ('\n') except the last:
+// what a reader of lines needs, without holding the whole file. Same refusals as read_text_file.
+void read_text_blocks(const std::filesystem::path& path,
+                      const std::function<void(std::string_view block)>& visit,
+                      size_t block_bytes = size_t{8} << 20);
+// The file's size in bytes, 0 when it cannot be told.
+size_t file_size_or_zero(const std::filesystem::path& path);
 
 struct OutputFile {
   std::filesystem::path path;

@@ -1,14 +1,16 @@
 // Speed of the trajectory benchmark on 1,000,000 timestamped poses (doc/performance.md):
 // association + SE(3) alignment + ATE + KITTI RPE, in memory; and file parsing.
 //   build/bin/rigcal_perf_trajectory                       (Google Benchmark)
-//   build/bin/rigcal_perf_trajectory --write DIR [N]       (writes DIR/gt.txt, DIR/est.txt)
+//   build/bin/rigcal_perf_trajectory --write DIR [N] [--hz H] [--epoch S]
+//       writes DIR/gt.txt, DIR/est.txt (TUM) and DIR/gt_kitti.txt, DIR/est_kitti.txt (the same
+//       poses as KITTI rows): N poses (1,000,000) at H Hz (10), at 10 m/s, stamps from S s (0)
 //   build/bin/rigcal_perf_trajectory --smoke               (10,000 poses: make test runs this)
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
 
 #include <cstring>
-#include <random>
 
+#include "../unit/synthetic_drive.h"
 #include "rigcal/bench/evaluate.h"
 #include "rigcal/io/files.h"
 #include "rigcal/io/trajectory_io.h"
@@ -21,28 +23,8 @@ using namespace rigcal;
 // --smoke: every size divided by this (make test runs each benchmark once, small).
 size_t g_size_divisor = 1;
 
-// A 10 Hz drive (~1 m a frame), GT and an estimate with drift on stamps 1 ms later.
-std::pair<Trajectory, Trajectory> make_pair(size_t n) {
-  std::mt19937_64 rng(1);
-  std::normal_distribution<double> noise(0.0, 0.02);
-  Trajectory gt, est;
-  gt.stamps.reserve(n), gt.T_world_body.reserve(n), est.stamps.reserve(n),
-      est.T_world_body.reserve(n);
-  Eigen::Vector3d p = Eigen::Vector3d::Zero();
-  double yaw = 0.0;
-  for (size_t i = 0; i < n; ++i) {
-    yaw += 0.02 * std::sin(1e-3 * static_cast<double>(i));
-    p += Eigen::Vector3d(std::cos(yaw), std::sin(yaw),
-                         0.01 * std::sin(1e-2 * static_cast<double>(i)));
-    const SE3 T = SE3::from_rotation_vector(Eigen::Vector3d(0, 0, yaw), p);
-    gt.stamps.push_back(Time::from_ns(static_cast<int64_t>(i) * 100'000'000));
-    gt.T_world_body.push_back(T);
-    est.stamps.push_back(Time::from_ns(static_cast<int64_t>(i) * 100'000'000 + 1'000'000));
-    est.T_world_body.push_back(
-        SE3::from_rotation_vector(Eigen::Vector3d(0, 0, yaw * 1.001),
-                                  p * 1.002 + Eigen::Vector3d(noise(rng), noise(rng), noise(rng))));
-  }
-  return {gt, est};
+std::pair<Trajectory, Trajectory> make_pair(size_t n, double hz = 10, int64_t epoch_s = 0) {
+  return testing::synthetic_drive(n, hz, epoch_s);
 }
 
 void BM_AssociateAlignAteKittiRpe(benchmark::State& state) {
@@ -81,12 +63,39 @@ BENCHMARK(BM_ParseTum)->Arg(1'000'000)->Unit(benchmark::kMillisecond);
 
 int main(int argc, char** argv) {
   if (argc >= 3 && std::strcmp(argv[1], "--write") == 0) {
-    const size_t n = argc >= 4 ? std::stoul(argv[3]) : 1'000'000;
-    const auto [gt, est] = make_pair(n);
-    rigcal::io::write_files_atomic(
-        {{std::string(argv[2]) + "/gt.txt", rigcal::io::trajectory_to_tum(gt)},
-         {std::string(argv[2]) + "/est.txt", rigcal::io::trajectory_to_tum(est)}});
-    fmt::print("wrote {}/gt.txt and {}/est.txt, {} poses each\n", argv[2], argv[2], n);
+    const std::string dir = argv[2];
+    size_t n = 1'000'000;
+    double hz = 10;
+    int64_t epoch_s = 0;
+    for (int i = 3; i < argc; ++i) {
+      if (std::strcmp(argv[i], "--hz") == 0 && i + 1 < argc) {
+        hz = std::stod(argv[++i]);
+      } else if (std::strcmp(argv[i], "--epoch") == 0 && i + 1 < argc) {
+        epoch_s = std::stoll(argv[++i]);
+      } else {
+        n = std::stoul(argv[i]);
+      }
+    }
+    const auto [gt, est] = make_pair(n, hz, epoch_s);
+    auto kitti = [](const Trajectory& t) {
+      std::string out;
+      out.reserve(t.size() * 200);
+      for (const SE3& T : t.T_world_body) {
+        const Eigen::Matrix4d m = T.matrix();
+        out += fmt::format(
+            "{:.9e} {:.9e} {:.9e} {:.9e} {:.9e} {:.9e} {:.9e} {:.9e} {:.9e} {:.9e} "
+            "{:.9e} {:.9e}\n",
+            m(0, 0), m(0, 1), m(0, 2), m(0, 3), m(1, 0), m(1, 1), m(1, 2), m(1, 3), m(2, 0),
+            m(2, 1), m(2, 2), m(2, 3));
+      }
+      return out;
+    };
+    rigcal::io::write_files_atomic({{dir + "/gt.txt", rigcal::io::trajectory_to_tum(gt)},
+                                    {dir + "/est.txt", rigcal::io::trajectory_to_tum(est)},
+                                    {dir + "/gt_kitti.txt", kitti(gt)},
+                                    {dir + "/est_kitti.txt", kitti(est)}});
+    fmt::print("wrote {}/{{gt,est}}.txt (TUM) and {{gt,est}}_kitti.txt, {} poses each at {:g} Hz\n",
+               dir, n, hz);
     return 0;
   }
   if (rigcal::perf::take_smoke_flag(argc, argv)) g_size_divisor = 100;

@@ -348,18 +348,27 @@ TEST_F(Cli, BenchPrintsTableWritesReportAndRefusesBadFiles) {
   EXPECT_TRUE(j["rpe"]["kitti"].contains("rot_deg_per_m"));
   EXPECT_EQ(j["align"]["T"].size(), 4u);
   // The plots: ground truth as a line, the estimate as 1999 points coloured by their ATE with its
-  // colour bar; the ATE along the trajectory as one line of 1999 points.
-  const Svg top = parse_svg(dir_ / "rep" / "trajectory_top.svg");
-  EXPECT_EQ(top.title, "Trajectories, top view (estimate coloured by ATE)");
+  // colour bar, in the helix's plane (xy: it climbs 0.2 m over 60 m); the ATE and the RPE along
+  // the trajectory as one line of 1999 (1998 pairs) points, with their rmse, mean, median and
+  // mean +- std as lines of two points.
+  const Svg top = parse_svg(dir_ / "rep" / "trajectory.svg");
+  EXPECT_EQ(top.title, "Trajectories in the xy plane (estimate coloured by ATE)");
   EXPECT_EQ(top.polyline_points, std::vector<size_t>{1999});
   EXPECT_EQ(top.circles, 1999u);
   EXPECT_TRUE(has_text(top, "ground truth"));
   EXPECT_TRUE(has_text(top, "ATE [m]"));
-  const Svg along = parse_svg(dir_ / "rep" / "ate_along.svg");
-  EXPECT_EQ(along.title, "ATE along the trajectory");
-  EXPECT_EQ(along.polyline_points, std::vector<size_t>{1999});
+  const Svg along = parse_svg(dir_ / "rep" / "ate.svg");
+  EXPECT_EQ(along.title, "ATE along the trajectory (translation)");
+  EXPECT_EQ(along.polyline_points, (std::vector<size_t>{1999, 2, 2, 2, 2, 2}));
   EXPECT_EQ(along.circles, 0u);
   EXPECT_TRUE(has_text(along, "translation error [m]"));
+  EXPECT_TRUE(has_text(along, "time since the first pair [s]"));
+  EXPECT_TRUE(
+      has_text(along, fmt::format("rmse {:.4g} m", j["ate"]["trans"]["rmse"].get<double>())));
+  const Svg rpe = parse_svg(dir_ / "rep" / "rpe.svg");
+  EXPECT_EQ(rpe.polyline_points, (std::vector<size_t>{1998, 2, 2, 2, 2, 2}));
+  EXPECT_EQ(j["plots"]["plane"], "xy");
+  EXPECT_FALSE(fs::exists(dir_ / "rep" / "per_pose.csv"));  // only with --per-pose
 
   const fs::path bad = write("bad.txt", "1 0 0 0 0 0 0 1\n2 0 0 0 0 0 0 1\n1.5 0 0 0 0 0 0 1\n");
   r = run("bench --gt " + gt.string() + " --est " + bad.string());
@@ -383,6 +392,58 @@ TEST_F(Cli, BenchPrintsTableWritesReportAndRefusesBadFiles) {
   r = run("bench --gt " + gt.string() + " --est " + est.string() + " --convention foo");
   EXPECT_EQ(r.status, 2);
   EXPECT_EQ(r.err, "rigcal: error: unknown convention 'foo'; expected rigcal, evo, kitti or vbr\n");
+}
+
+// KITTI's poses are in the camera frame, y down: the car drives in the x-z plane, and a plot of
+// x-y draws a line. The plane is chosen from the spread; without stamps the plots run over pose
+// indices. bench.json stays a summary; the rows go to CSV files only with --per-pose.
+TEST_F(Cli, BenchKittiPosesDrawInTheirPlaneAndRowsOnlyWhenAsked) {
+  std::string gt_text, est_text;
+  const int n = 600;
+  for (int i = 0; i < n; ++i) {
+    const double yaw = 0.01 * i, x = 20 * std::sin(yaw), z = 20 * (1 - std::cos(yaw)) + 0.5 * i;
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    auto row = [&](double dx) {
+      return fmt::format("{} {} {} {} {} {} {} {} {} {} {} {}\n", R(0, 0), R(0, 1), R(0, 2), x + dx,
+                         R(1, 0), R(1, 1), R(1, 2), 0.01 * std::sin(0.1 * i), R(2, 0), R(2, 1),
+                         R(2, 2), z);
+    };
+    gt_text += row(0.0);
+    est_text += row(0.002 * i);
+  }
+  const fs::path gt = write("k_gt.txt", gt_text), est = write("k_es.txt", est_text);
+  const fs::path rep = dir_ / "krep";
+  CliRun r = run("bench --gt " + gt.string() + " --est " + est.string() + " --report " +
+                 rep.string() + " --per-pose");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(slurp(rep / "bench.json"));
+  EXPECT_EQ(j["plots"]["plane"], "xz");
+  EXPECT_EQ(j["plots"]["along"], "pose index");
+  EXPECT_LT(fs::file_size(rep / "bench.json"), 8000u);
+  const Svg top = parse_svg(rep / "trajectory.svg");
+  EXPECT_EQ(top.title, "Trajectories in the xz plane (estimate coloured by ATE)");
+  EXPECT_TRUE(has_text(top, "z [m]"));
+  EXPECT_TRUE(has_text(parse_svg(rep / "ate.svg"), "pose index"));
+  // One row a matched pose, one a segment of each kind, as the summary counts them.
+  const std::string per_pose = slurp(rep / "per_pose.csv");
+  EXPECT_EQ(per_pose.substr(0, per_pose.find('\n')),
+            "index,gt_x,gt_y,gt_z,est_x,est_y,est_z,ate_trans_m,ate_rot_deg");
+  EXPECT_EQ(std::count(per_pose.begin(), per_pose.end(), '\n'), n + 1);
+  for (const char* kind : {"kitti", "vbr", "delta"}) {
+    const std::string rows = slurp(rep / fmt::format("segments_{}.csv", kind));
+    EXPECT_EQ(static_cast<size_t>(std::count(rows.begin(), rows.end(), '\n')),
+              j["rpe"][kind]["n_segments"].get<size_t>() + 1)
+        << kind;
+  }
+  // --plot-mode overrides the choice; --per-pose needs a folder to write in.
+  r = run("bench --gt " + gt.string() + " --est " + est.string() + " --report " +
+          (dir_ / "kxy").string() + " --plot-mode xy");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(parse_svg(dir_ / "kxy" / "trajectory.svg").title,
+            "Trajectories in the xy plane (estimate coloured by ATE)");
+  r = run("bench --gt " + gt.string() + " --est " + est.string() + " --per-pose");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--per-pose"), std::string::npos) << r.err;
 }
 
 TEST_F(Cli, BenchLeaderboardCountsMissingSequencesAsFailed) {
