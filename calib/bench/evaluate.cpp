@@ -348,11 +348,24 @@ EvalResult evaluate(Trajectory gt, Trajectory est, const EvalOptions& opt) {
   if (res.association == Association::interpolate) {
     Interpolated in = interpolate_gt(gt, est, opt.max_gap);
     m_gt = std::move(in.T_world_gt);
-    reserve_huge(m_est, in.est.size());
-    reserve_huge(m_stamps, in.est.size());
-    for (size_t i : in.est) {
-      m_est.push_back(est.T_world_body[i]);
-      m_stamps.push_back(est.stamps[i]);
+    gt = Trajectory{};
+    if (!in.est.empty() && in.est.back() - in.est.front() + 1 == in.est.size()) {
+      // A run of consecutive estimate poses (the usual case): moved, not copied.
+      const auto first = static_cast<std::ptrdiff_t>(in.est.front());
+      const auto end = static_cast<std::ptrdiff_t>(in.est.back() + 1);
+      m_est = std::move(est.T_world_body);
+      m_stamps = std::move(est.stamps);
+      m_est.erase(m_est.begin() + end, m_est.end());
+      m_est.erase(m_est.begin(), m_est.begin() + first);
+      m_stamps.erase(m_stamps.begin() + end, m_stamps.end());
+      m_stamps.erase(m_stamps.begin(), m_stamps.begin() + first);
+    } else {
+      reserve_huge(m_est, in.est.size());
+      reserve_huge(m_stamps, in.est.size());
+      for (size_t i : in.est) {
+        m_est.push_back(est.T_world_body[i]);
+        m_stamps.push_back(est.stamps[i]);
+      }
     }
     res.notes.push_back(fmt::format(
         "ground truth interpolated (slerp + linear) at the estimate's stamps inside GT intervals "

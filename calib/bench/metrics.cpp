@@ -301,6 +301,17 @@ std::vector<double> cumulative_distances(const std::vector<SE3>& T_world_body) {
   return dist;
 }
 
+namespace {
+// The angle of a rotation from its antisymmetric part and its trace: sin and cos of the angle,
+// accurate at small angles (the sine from the differences, not from a cosine near 1).
+double angle_of(const Eigen::Matrix3d& M) {
+  const double s =
+      0.5 * Eigen::Vector3d(M(2, 1) - M(1, 2), M(0, 2) - M(2, 0), M(1, 0) - M(0, 1)).norm();
+  const double c = 0.5 * (M.trace() - 1.0);
+  return std::atan2(s, c);
+}
+}  // namespace
+
 void for_each_length_segment(const std::vector<SE3>& T_world_gt,
                              const std::vector<SE3>& T_world_est,
                              const std::vector<double>& lengths, size_t step,
@@ -336,7 +347,7 @@ void for_each_length_segment(const std::vector<SE3>& T_world_gt,
           const Eigen::Vector3d d_est = ei.R.transpose() * (ej.t - ei.t);
           const Eigen::Matrix3d M = A * gj.R * ej.R.transpose();
           slots[slot] = {first, last, lengths[k], (d_gt - d_est).norm(),
-                         rotation_angle(M) * (180.0 / M_PI)};
+                         angle_of(M) * (180.0 / M_PI)};
         }
       }
     });
