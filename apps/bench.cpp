@@ -18,6 +18,16 @@ void run_pair(const bench::BenchOptions& o) {
     fmt::print("{}\n", line);
 }
 
+void run_several(const bench::BenchOptions& o) {
+  for (const std::string& line : bench::several_summary(o, bench::score_several(o)))
+    fmt::print("{}\n", line);
+}
+
+void run_compare(const std::vector<std::string>& results, const std::string& report) {
+  fmt::print("{}", bench::compare_markdown(bench::compare_results(results, report)));
+  if (!report.empty()) fmt::print("report: {}/compare.md (.csv, .json), compare_ate.svg\n", report);
+}
+
 void run_leaderboard(const bench::BenchOptions& o) {
   const bench::Leaderboard board =
       bench::score_leaderboard(o, [](std::string_view msg) { fmt::print(stderr, "{}\n", msg); });
@@ -44,7 +54,9 @@ void add_bench(CLI::App& app) {
       "Conventions: rigcal (correct, default), evo, kitti (devkit), vbr (official evaluator).\n"
       "Every figure is defined in doc/bench.md.");
   cmd->add_option("--gt", o->gt, "ground-truth trajectory");
-  cmd->add_option("--est", o->est, "estimated trajectory");
+  cmd->add_option("--est", o->ests,
+                  "estimated trajectory; repeat it to score several against one ground truth\n"
+                  "(a table of all, each one's report in REPORT/<file stem>/, and plots of all)");
   cmd->add_option("--format", o->format, "auto | tum | kitti | euroc (both files)")
       ->capture_default_str();
   cmd->add_option("--gt-format", o->gt_format, "format of the ground truth only");
@@ -104,10 +116,24 @@ void add_bench(CLI::App& app) {
   cmd->add_option("--rpe-max", o->rpe_max, "leaderboard: RPE threshold for the rank, %")
       ->check(finite_number(true))
       ->capture_default_str();
-  cmd->callback([o] {
+  auto compared = std::make_shared<std::vector<std::string>>();
+  auto compare_report = std::make_shared<std::string>();
+  CLI::App* compare = cmd->add_subcommand(
+      "compare",
+      "Compare saved results (evo_res's job): a table of their figures (ATE statistics, each\n"
+      "RPE kind) and a plot of their ATE. RESULT: a bench.json, or the --report folder holding\n"
+      "one; a result is named by its folder.");
+  compare->add_option("results", *compared, "RESULT...")->required();
+  compare->add_option("--report", *compare_report,
+                      "folder for compare.md, compare.csv, compare.json, compare_ate.svg");
+  compare->callback([compared, compare_report] { run_compare(*compared, *compare_report); });
+  cmd->callback([o, compare] {
+    if (compare->parsed()) return;
     if (!o->gt_dir.empty()) return run_leaderboard(*o);
-    if (o->gt.empty() || o->est.empty())
+    if (o->gt.empty() || o->ests.empty())
       throw Error("give --gt and --est (or --gt-dir and --est-dir)");
+    if (o->ests.size() > 1) return run_several(*o);
+    o->est = o->ests.front();
     run_pair(*o);
   });
 }

@@ -39,7 +39,7 @@ echo
 "$rigcal" bench --gt "$bench_in/drive_gt.txt" --est "$bench_in/drive_es.txt" --convention kitti \
   --association nearest | tail -n 3
 echo
-echo "Benchmark report (bench.json, trajectory_top.svg, ate_along.svg) in $out/bench"
+echo "Benchmark report (bench.json, trajectory.svg, ate.svg, rpe.svg) in $out/bench"
 
 echo
 echo "== simulated session of the sample rig (truth in $out/sim/truth.yaml and truth.json);"

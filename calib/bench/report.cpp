@@ -202,7 +202,7 @@ void write_bench_report(const EvalResult& r, const fs::path& dir,
   report::Plot rpe_plot;
   const RpeResult* delta = find_rpe(r, "delta");
   rpe_plot.title = delta ? fmt::format("RPE, {} (translation)", delta->definition) : "RPE";
-  rpe_plot.x_label = x_label + " (the pair's first pose)";
+  rpe_plot.x_label = fmt::format("{} (the pair's first pose)", x_label);
   rpe_plot.y_label = "translation error [m]";
   if (delta && !delta->segments.empty()) {
     report::PlotSeries d{"RPE", {}, {}, {}};
@@ -223,7 +223,7 @@ void write_bench_report(const EvalResult& r, const fs::path& dir,
     files.push_back({dir / "per_pose.csv", per_pose_csv(r)});
     for (const RpeResult& k : r.rpe) {
       if (k.segments.empty()) continue;
-      names.push_back("segments_" + k.kind + ".csv");
+      names.push_back(fmt::format("segments_{}.csv", k.kind));
       files.push_back({dir / names.back(), segments_csv(k)});
     }
     summary["per_pose_files"] = names;

@@ -3,12 +3,14 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <filesystem>
 #include <future>
 
 #include "rigcal/bench/report.h"
 #include "rigcal/core/error.h"
 
 namespace rigcal::bench {
+namespace fs = std::filesystem;
 namespace {
 
 std::string stats_line(std::string_view label, const Stats& s) {
@@ -128,6 +130,77 @@ std::vector<std::string> pair_summary(const BenchOptions& o, const PairRun& run)
                               o.per_pose ? ", per_pose.csv, segments_<kind>.csv" : ""));
   }
   return out;
+}
+
+SeveralRun score_several(const BenchOptions& o) {
+  SeveralRun out;
+  const EvalOptions options = eval_options(o);
+  const io::TrajectoryFile gt = io::read_trajectory(o.gt, read_options(o, o.gt_format, o.gt_times));
+  std::vector<NamedResult> named;
+  for (const std::string& est : o.ests) {
+    PairRun run;
+    run.gt = gt;
+    run.est = io::read_trajectory(est, read_options(o, o.est_format, o.est_times));
+    EvalOptions with_formats = options;
+    with_formats.gt_stamps_ns = gt.format == io::TrajectoryFormat::euroc;
+    with_formats.est_stamps_ns = run.est.format == io::TrajectoryFormat::euroc;
+    try {
+      run.result =
+          evaluate(std::move(run.gt.trajectory), std::move(run.est.trajectory), with_formats);
+    } catch (const Error& e) {
+      throw Error(fmt::format("{} against {}: {}", est, o.gt, e.what()));
+    }
+    named.push_back({fs::path(est).stem().string(), nlohmann::json::object()});
+    out.runs.push_back(std::move(run));
+  }
+  make_names_unique(named);
+  for (const NamedResult& n : named) out.names.push_back(n.name);
+  if (!o.report.empty()) {
+    const fs::path dir = o.report;
+    std::vector<EvalResult> results;
+    for (size_t k = 0; k < out.runs.size(); ++k) {
+      const std::map<std::string, std::string> inputs{{"gt", o.gt}, {"est", o.ests[k]}};
+      write_bench_report(out.runs[k].result, dir / out.names[k], inputs,
+                         {plot_mode_from_string(o.plot_mode), o.per_pose});
+      named[k].summary = bench_json(out.runs[k].result, inputs);
+      results.push_back(out.runs[k].result);
+    }
+    write_compare_report(named, dir);
+    write_overlay_plots(results, out.names, dir, plot_mode_from_string(o.plot_mode));
+  }
+  return out;
+}
+
+std::vector<std::string> several_summary(const BenchOptions& o, const SeveralRun& run) {
+  std::vector<std::string> out;
+  std::vector<NamedResult> named;
+  for (size_t k = 0; k < run.runs.size(); ++k) {
+    BenchOptions one = o;
+    one.est = o.ests[k];
+    one.report.clear();
+    out.push_back(fmt::format("== {}", run.names[k]));
+    for (std::string& line : pair_summary(one, run.runs[k])) out.push_back(std::move(line));
+    named.push_back({run.names[k], bench_json(run.runs[k].result, {})});
+  }
+  out.push_back("");
+  out.push_back(compare_markdown(named));
+  if (!o.report.empty()) {
+    out.push_back(fmt::format(
+        "report: {0}/compare.md (.csv, .json), compare_ate.svg, trajectories.svg, ate.svg, and "
+        "each estimate's in {0}/<name>/",
+        o.report));
+  }
+  return out;
+}
+
+std::vector<NamedResult> compare_results(const std::vector<std::string>& paths,
+                                         const std::string& report) {
+  if (paths.empty()) throw Error("give the results to compare: bench.json files or their folders");
+  std::vector<NamedResult> results;
+  for (const std::string& p : paths) results.push_back(read_result(p));
+  make_names_unique(results);
+  if (!report.empty()) write_compare_report(results, report);
+  return results;
 }
 
 Leaderboard score_leaderboard(const BenchOptions& o,

@@ -7,6 +7,7 @@
 #include <string_view>
 #include <vector>
 
+#include "rigcal/bench/compare.h"
 #include "rigcal/bench/evaluate.h"
 #include "rigcal/bench/leaderboard.h"
 #include "rigcal/io/trajectory_io.h"
@@ -14,6 +15,8 @@
 namespace rigcal::bench {
 
 struct BenchOptions {
+  // --est: one estimate (est), or several against one ground truth (ests, est unused).
+  std::vector<std::string> ests;
   std::string gt, est, format = "auto", gt_format, est_format, gt_times, est_times;
   std::string align, association, convention = "rigcal", report;
   size_t align_first = 0;
@@ -45,6 +48,22 @@ struct PairRun {
 PairRun score_pair(const BenchOptions& o);
 // The figures as the command prints them, one line each.
 std::vector<std::string> pair_summary(const BenchOptions& o, const PairRun& run);
+
+// Several estimates (o.ests) against o.gt, each scored as score_pair scores one; with o.report,
+// each one's report in REPORT/<name>/ (the estimate file's stem) and, in REPORT, the comparison
+// (compare.md, .csv, .json, compare_ate.svg) and the overlay plots (trajectories.svg, ate.svg).
+struct SeveralRun {
+  std::vector<std::string> names;
+  std::vector<PairRun> runs;
+};
+SeveralRun score_several(const BenchOptions& o);
+// Each estimate's lines as pair_summary prints them, then the comparison table.
+std::vector<std::string> several_summary(const BenchOptions& o, const SeveralRun& run);
+
+// `rigcal bench compare RESULT...`: the saved results (bench.json files or folders holding one)
+// read, named by their folders; with `report`, the comparison written there.
+std::vector<NamedResult> compare_results(const std::vector<std::string>& paths,
+                                         const std::string& report);
 
 // Loads the leaderboard's folders, scores every run (`tell` receives a line per failure) and
 // writes the report when o.report is set.

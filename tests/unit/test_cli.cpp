@@ -446,6 +446,52 @@ TEST_F(Cli, BenchKittiPosesDrawInTheirPlaneAndRowsOnlyWhenAsked) {
   EXPECT_NE(r.err.find("--per-pose"), std::string::npos) << r.err;
 }
 
+// Several estimates against one ground truth, then the saved results compared (evo_res): one
+// table for both, the same from the run and from the results read back.
+TEST_F(Cli, BenchSeveralEstimatesAndTheirSavedResultsCompared) {
+  const fs::path gt = write("seq_gt.txt", helix_tum(1500, 0.0, 0.0));
+  const fs::path good = write("good.txt", helix_tum(1500, 0.002, 0.004));
+  const fs::path poor = write("poor.txt", helix_tum(1500, 0.03, 0.004));
+  const fs::path rep = dir_ / "several";
+  CliRun r = run("bench --gt " + gt.string() + " --est " + good.string() + " --est " +
+                 poor.string() + " --report " + rep.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("== good"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("== poor"), std::string::npos) << r.out;
+  const nlohmann::json jg = nlohmann::json::parse(slurp(rep / "good" / "bench.json"));
+  const nlohmann::json jp = nlohmann::json::parse(slurp(rep / "poor" / "bench.json"));
+  EXPECT_LT(jg["ate"]["trans"]["rmse"].get<double>(), jp["ate"]["trans"]["rmse"].get<double>());
+  // The table: a row an estimate, its ATE rmse as each one's bench.json holds it.
+  const std::string table = slurp(rep / "compare.md");
+  for (const auto& [name, j] : {std::pair{"good", jg}, {"poor", jp}}) {
+    const std::string row = fmt::format("| {} | rigcal | {} | {:.6g} |", name, j["n_pairs"].dump(),
+                                        j["ate"]["trans"]["rmse"].get<double>());
+    EXPECT_NE(table.find(row), std::string::npos) << row << "\n" << table;
+  }
+  EXPECT_NE(r.out.find(table), std::string::npos);
+  // Plots of both: the ground truth and two estimates; two ATE lines.
+  EXPECT_EQ(parse_svg(rep / "trajectories.svg").polyline_points.size(), 3u);
+  EXPECT_EQ(parse_svg(rep / "ate.svg").polyline_points.size(), 2u);
+  EXPECT_TRUE(has_text(parse_svg(rep / "ate.svg"), "poor"));
+
+  // `bench compare` on the saved results gives the same table.
+  r = run("bench compare " + (rep / "good").string() + " " +
+          (rep / "poor" / "bench.json").string() + " --report " + (dir_ / "cmp").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(slurp(dir_ / "cmp" / "compare.md"), table);
+  const nlohmann::json cj = nlohmann::json::parse(slurp(dir_ / "cmp" / "compare.json"));
+  EXPECT_EQ(cj["results"].size(), 2u);
+  EXPECT_TRUE(fs::exists(dir_ / "cmp" / "compare_ate.svg"));
+  // What is not a result is named.
+  const fs::path other = write("other.json", "{\"a\": 1}");
+  r = run("bench compare " + other.string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("other.json: not a rigcal bench result"), std::string::npos) << r.err;
+  r = run("bench compare " + (dir_ / "missing").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("no such file"), std::string::npos) << r.err;
+}
+
 TEST_F(Cli, BenchLeaderboardCountsMissingSequencesAsFailed) {
   fs::create_directories(dir_ / "gt");
   fs::create_directories(dir_ / "est" / "good");
