@@ -177,13 +177,13 @@ void write_compare_report(const std::vector<NamedResult>& results, const fs::pat
                           {dir / "compare_ate.svg", report::render_svg(plot)}});
 }
 
-void write_overlay_plots(const std::vector<EvalResult>& results,
+void write_overlay_plots(const std::vector<const EvalResult*>& results,
                          const std::vector<std::string>& names, const fs::path& dir,
                          PlotMode mode) {
   if (results.empty()) return;
-  const EvalResult& first = results.front();
+  const EvalResult& first = *results.front();
   if (mode == PlotMode::automatic) mode = dominant_plane(first.p_gt);
-  const int a = mode == PlotMode::yz ? 1 : 0, b = mode == PlotMode::xy ? 1 : 2;
+  const auto [a, b] = plane_axes(mode);
   const char* axis = "xyz";
   report::Plot top;
   top.title = fmt::format("Trajectories in the {} plane (each estimate aligned)", to_string(mode));
@@ -200,7 +200,7 @@ void write_overlay_plots(const std::vector<EvalResult>& results,
   top.series.push_back(std::move(gt));
   const Time t0 = first.stamps.empty() ? Time{} : first.stamps.front();
   for (size_t k = 0; k < results.size(); ++k) {
-    const EvalResult& r = results[k];
+    const EvalResult& r = *results[k];
     report::PlotSeries line{names[k], {}, {}, {}}, err{names[k], {}, r.ate_trans_errors, {}};
     for (const Eigen::Vector3d& p : r.p_est_aligned) line.x.push_back(p[a]), line.y.push_back(p[b]);
     for (size_t i = 0; i < r.stamps.size(); ++i) {

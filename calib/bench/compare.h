@@ -38,7 +38,7 @@ void write_compare_report(const std::vector<NamedResult>& results,
 // Several estimates against one ground truth, evaluated with keep_per_pose: DIR/trajectories.svg
 // (the ground truth and every aligned estimate, in the ground truth's plane) and DIR/ate.svg
 // (each estimate's ATE along the trajectory).
-void write_overlay_plots(const std::vector<EvalResult>& results,
+void write_overlay_plots(const std::vector<const EvalResult*>& results,
                          const std::vector<std::string>& names, const std::filesystem::path& dir,
                          PlotMode mode);
 

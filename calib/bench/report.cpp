@@ -62,6 +62,17 @@ PlotMode dominant_plane(const std::vector<Eigen::Vector3d>& positions) {
   return least == 0 ? PlotMode::yz : least == 1 ? PlotMode::xz : PlotMode::xy;
 }
 
+std::pair<int, int> plane_axes(PlotMode mode) {
+  switch (mode) {
+    case PlotMode::xz:
+      return {0, 2};
+    case PlotMode::yz:
+      return {1, 2};
+    default:
+      return {0, 1};
+  }
+}
+
 nlohmann::json bench_json(const EvalResult& r, const std::map<std::string, std::string>& inputs) {
   nlohmann::json j;
   j["tool_version"] = version_string();
@@ -105,18 +116,6 @@ nlohmann::json bench_json(const EvalResult& r, const std::map<std::string, std::
 }
 
 namespace {
-
-// The positions' two coordinates in the plot's plane.
-std::pair<int, int> plane_axes(PlotMode mode) {
-  switch (mode) {
-    case PlotMode::xz:
-      return {0, 2};
-    case PlotMode::yz:
-      return {1, 2};
-    default:
-      return {0, 1};
-  }
-}
 
 // Horizontal lines at a statistic's rmse, mean, median and mean +- std (evo's error plots).
 void add_statistics_lines(report::Plot& plot, const Stats& s, double x0, double x1,

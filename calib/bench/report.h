@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "rigcal/bench/leaderboard.h"
@@ -20,6 +21,8 @@ PlotMode plot_mode_from_string(std::string_view name);  // auto|xy|xz|yz
 std::string_view to_string(PlotMode mode);
 // The two axes along which the positions spread most (KITTI's camera frame, y down: xz).
 PlotMode dominant_plane(const std::vector<Eigen::Vector3d>& positions);
+// The plane's two coordinates (0 x, 1 y, 2 z); `automatic` as xy.
+std::pair<int, int> plane_axes(PlotMode mode);
 
 struct ReportOptions {
   PlotMode plot_mode = PlotMode::automatic;

@@ -58,6 +58,24 @@ EvalOptions eval_options(const BenchOptions& o) {
   return e;
 }
 
+namespace {
+
+// run.result from run.gt and run.est as read (their trajectories moved into the evaluation).
+void evaluate_read(const BenchOptions& o, const EvalOptions& options, const std::string& est,
+                   PairRun& run) {
+  EvalOptions with_formats = options;
+  with_formats.gt_stamps_ns = run.gt.format == io::TrajectoryFormat::euroc;
+  with_formats.est_stamps_ns = run.est.format == io::TrajectoryFormat::euroc;
+  try {
+    run.result =
+        evaluate(std::move(run.gt.trajectory), std::move(run.est.trajectory), with_formats);
+  } catch (const Error& e) {
+    throw Error(fmt::format("{} against {}: {}", est, o.gt, e.what()));
+  }
+}
+
+}  // namespace
+
 PairRun score_pair(const BenchOptions& o) {
   const EvalOptions options = eval_options(o);
   PairRun run;
@@ -67,15 +85,7 @@ PairRun score_pair(const BenchOptions& o) {
   });
   run.gt = io::read_trajectory(o.gt, read_options(o, o.gt_format, o.gt_times));
   run.est = est.get();
-  EvalOptions with_formats = options;
-  with_formats.gt_stamps_ns = run.gt.format == io::TrajectoryFormat::euroc;
-  with_formats.est_stamps_ns = run.est.format == io::TrajectoryFormat::euroc;
-  try {
-    run.result =
-        evaluate(std::move(run.gt.trajectory), std::move(run.est.trajectory), with_formats);
-  } catch (const Error& e) {
-    throw Error(fmt::format("{} against {}: {}", o.est, o.gt, e.what()));
-  }
+  evaluate_read(o, options, o.est, run);
   if (!o.report.empty()) {
     write_bench_report(run.result, o.report, {{"gt", o.gt}, {"est", o.est}},
                        {plot_mode_from_string(o.plot_mode), o.per_pose});
@@ -136,54 +146,44 @@ SeveralRun score_several(const BenchOptions& o) {
   SeveralRun out;
   const EvalOptions options = eval_options(o);
   const io::TrajectoryFile gt = io::read_trajectory(o.gt, read_options(o, o.gt_format, o.gt_times));
-  std::vector<NamedResult> named;
   for (const std::string& est : o.ests) {
     PairRun run;
     run.gt = gt;
     run.est = io::read_trajectory(est, read_options(o, o.est_format, o.est_times));
-    EvalOptions with_formats = options;
-    with_formats.gt_stamps_ns = gt.format == io::TrajectoryFormat::euroc;
-    with_formats.est_stamps_ns = run.est.format == io::TrajectoryFormat::euroc;
-    try {
-      run.result =
-          evaluate(std::move(run.gt.trajectory), std::move(run.est.trajectory), with_formats);
-    } catch (const Error& e) {
-      throw Error(fmt::format("{} against {}: {}", est, o.gt, e.what()));
-    }
-    named.push_back({fs::path(est).stem().string(), nlohmann::json::object()});
+    evaluate_read(o, options, est, run);
+    out.named.push_back(
+        {fs::path(est).stem().string(), bench_json(run.result, {{"gt", o.gt}, {"est", est}})});
     out.runs.push_back(std::move(run));
   }
-  make_names_unique(named);
-  for (const NamedResult& n : named) out.names.push_back(n.name);
+  make_names_unique(out.named);
   if (!o.report.empty()) {
     const fs::path dir = o.report;
-    std::vector<EvalResult> results;
+    std::vector<const EvalResult*> results;
+    std::vector<std::string> names;
     for (size_t k = 0; k < out.runs.size(); ++k) {
-      const std::map<std::string, std::string> inputs{{"gt", o.gt}, {"est", o.ests[k]}};
-      write_bench_report(out.runs[k].result, dir / out.names[k], inputs,
+      write_bench_report(out.runs[k].result, dir / out.named[k].name,
+                         {{"gt", o.gt}, {"est", o.ests[k]}},
                          {plot_mode_from_string(o.plot_mode), o.per_pose});
-      named[k].summary = bench_json(out.runs[k].result, inputs);
-      results.push_back(out.runs[k].result);
+      results.push_back(&out.runs[k].result);
+      names.push_back(out.named[k].name);
     }
-    write_compare_report(named, dir);
-    write_overlay_plots(results, out.names, dir, plot_mode_from_string(o.plot_mode));
+    write_compare_report(out.named, dir);
+    write_overlay_plots(results, names, dir, plot_mode_from_string(o.plot_mode));
   }
   return out;
 }
 
 std::vector<std::string> several_summary(const BenchOptions& o, const SeveralRun& run) {
   std::vector<std::string> out;
-  std::vector<NamedResult> named;
   for (size_t k = 0; k < run.runs.size(); ++k) {
     BenchOptions one = o;
     one.est = o.ests[k];
     one.report.clear();
-    out.push_back(fmt::format("== {}", run.names[k]));
+    out.push_back(fmt::format("== {}", run.named[k].name));
     for (std::string& line : pair_summary(one, run.runs[k])) out.push_back(std::move(line));
-    named.push_back({run.names[k], bench_json(run.runs[k].result, {})});
   }
   out.push_back("");
-  out.push_back(compare_markdown(named));
+  out.push_back(compare_markdown(run.named));
   if (!o.report.empty()) {
     out.push_back(fmt::format(
         "report: {0}/compare.md (.csv, .json), compare_ate.svg, trajectories.svg, ate.svg, and "

@@ -53,7 +53,7 @@ std::vector<std::string> pair_summary(const BenchOptions& o, const PairRun& run)
 // each one's report in REPORT/<name>/ (the estimate file's stem) and, in REPORT, the comparison
 // (compare.md, .csv, .json, compare_ate.svg) and the overlay plots (trajectories.svg, ate.svg).
 struct SeveralRun {
-  std::vector<std::string> names;
+  std::vector<NamedResult> named;  // each estimate's name and summary (bench.json)
   std::vector<PairRun> runs;
 };
 SeveralRun score_several(const BenchOptions& o);

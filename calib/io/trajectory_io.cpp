@@ -39,7 +39,6 @@ bool is_dashed_date(std::string_view s) {
 
 constexpr size_t kMaxFields = 16;
 using Fields = std::array<std::string_view, kMaxFields>;
-size_t split_into(std::string_view line, Fields& f) { return split_fields(line, f); }
 
 TrajectoryFormat detect(std::string_view first_line, int line_number, const std::string& headers,
                         std::string_view file_name) {
@@ -47,7 +46,7 @@ TrajectoryFormat detect(std::string_view first_line, int line_number, const std:
     return TrajectoryFormat::euroc;
   }
   Fields fields;
-  const size_t n = split_into(first_line, fields);
+  const size_t n = split_fields(first_line, fields);
   const bool csv = file_name.size() >= 4 && file_name.substr(file_name.size() - 4) == ".csv";
   if (csv && n >= 8 && is_integer_text(fields[0])) return TrajectoryFormat::euroc;
   if (n == 12) return TrajectoryFormat::kitti;
@@ -133,7 +132,7 @@ struct PoseReader {
 
   void pose(std::string_view text) {
     Fields f;
-    const size_t n = split_into(text, f);
+    const size_t n = split_fields(text, f);
     Trajectory& traj = out.trajectory;
     const int line = line_number;
     SE3 T;
