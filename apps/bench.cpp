@@ -89,10 +89,26 @@ void add_bench(CLI::App& app) {
   cmd->add_option("--delta", o->delta, "RPE delta of the evo-style pairs")
       ->check(finite_number(true))
       ->capture_default_str();
-  cmd->add_option("--delta-unit", o->delta_unit, "f (frames) | m (metres of the estimate's path)")
+  cmd->add_option("--delta-unit", o->delta_unit,
+                  "f (frames) | m (metres of path) | d (degrees) | r (radians of rotation)")
       ->capture_default_str();
-  cmd->add_flag("--all-pairs", o->all_pairs,
+  cmd->add_flag("--all-pairs,--all_pairs", o->all_pairs,
                 "evo's --all_pairs: every start, not consecutive pairs");
+  cmd->add_option("--delta-tol,--delta_tol", o->delta_tol,
+                  "all pairs in m, d or r: a pair's delta within delta * (1 +- TOL)")
+      ->check(finite_number(true))
+      ->capture_default_str();
+  cmd->add_flag("--pairs-from-reference,--pairs_from_reference", o->pairs_from_reference,
+                "RPE pairs chosen on the ground truth's path or rotation, not the estimate's");
+  cmd->add_option("--t-offset,--t_offset", o->t_offset,
+                  "seconds added to the estimate's stamps before association")
+      ->check(seconds_within(-1e9));
+  cmd->add_option("--t-start,--t_start", o->t_start,
+                  "only ground-truth poses stamped at or after this time, s (the file's clock)")
+      ->check(seconds_within(-1e10, 1e10));
+  cmd->add_option("--t-end,--t_end", o->t_end,
+                  "only ground-truth poses stamped at or before this time, s")
+      ->check(seconds_within(-1e10, 1e10));
   cmd->add_option(
       "--duplicate-stamps", o->duplicates,
       "poses with equal stamps: error | drop (keep the first) | keep (default: keep for\n"

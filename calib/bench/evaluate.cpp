@@ -76,19 +76,26 @@ RpeResult make_rpe(std::string kind, std::string definition, std::vector<Segment
 }
 
 std::string delta_definition(const EvalOptions& o) {
-  return fmt::format("{} pairs {:g} {} apart{}", o.all_pairs ? "all" : "consecutive", o.delta,
-                     o.delta_unit == DeltaUnit::frames ? "frame(s)" : "m of the estimate's path",
-                     o.delta_unit == DeltaUnit::meters && o.all_pairs ? " (+-10 %)" : "");
+  const bool path = o.delta_unit == DeltaUnit::meters;
+  const bool frames = o.delta_unit == DeltaUnit::frames;
+  return fmt::format(
+      "{} pairs {:g} {}{} apart{}", o.all_pairs ? "all" : "consecutive", o.delta,
+      frames ? "frame(s)" : to_string(o.delta_unit),
+      frames ? ""
+             : fmt::format(" of the {}'s {}", o.pairs_from_reference ? "ground truth" : "estimate",
+                           path ? "path" : "rotation"),
+      !frames && o.all_pairs ? fmt::format(" (+-{:g} %)", 100.0 * o.delta_tol) : "");
 }
 
-std::vector<std::pair<size_t, size_t>> delta_pairs(const std::vector<SE3>& est,
+std::vector<std::pair<size_t, size_t>> delta_pairs(const std::vector<SE3>& gt,
+                                                   const std::vector<SE3>& est,
                                                    const EvalOptions& o) {
-  std::vector<std::pair<size_t, size_t>> pairs =
-      evo_delta_pairs(est, o.delta, o.delta_unit, o.all_pairs);
+  std::vector<std::pair<size_t, size_t>> pairs = evo_delta_pairs(
+      o.pairs_from_reference ? gt : est, o.delta, o.delta_unit, o.all_pairs, o.delta_tol);
   if (pairs.empty()) {
     throw Error(fmt::format(
-        "RPE delta {:g} {} gives no pose pair on this trajectory; use a smaller --delta", o.delta,
-        o.delta_unit == DeltaUnit::frames ? "frames" : "m"));
+        "RPE delta {:g} {} gives no pose pair on this trajectory; use a smaller --delta{}", o.delta,
+        to_string(o.delta_unit), o.all_pairs ? " or a larger --delta-tol" : ""));
   }
   return pairs;
 }
@@ -281,6 +288,38 @@ std::string_view to_string(Association association) {
   return "?";
 }
 
+namespace {
+
+// evo's reduce_to_time_range on the ground truth: the poses whose float64 seconds are within
+// [t_start, t_end] (each bound defaulting to the first or last stamp). Returns the note.
+std::string crop_to_time_range(Trajectory& gt, const EvalOptions& o) {
+  const std::vector<double> s = evo_seconds(gt.stamps, o.gt_stamps_ns);
+  const double lo = o.t_start.value_or(s.front()), hi = o.t_end.value_or(s.back());
+  if (o.t_start && o.t_end && lo > hi) {
+    throw Error(fmt::format("--t-start {} s is after --t-end {} s", lo, hi));
+  }
+  Trajectory kept;
+  for (size_t i = 0; i < s.size(); ++i) {
+    if (lo <= s[i] && s[i] <= hi) {
+      kept.stamps.push_back(gt.stamps[i]);
+      kept.T_world_body.push_back(gt.T_world_body[i]);
+    }
+  }
+  if (kept.empty()) {
+    throw Error(
+        fmt::format("no ground-truth pose between --t-start and --t-end ({}..{} s); its stamps "
+                    "run {}..{} s",
+                    lo, hi, to_seconds_text(gt.stamps.front()), to_seconds_text(gt.stamps.back())));
+  }
+  const std::string note =
+      fmt::format("ground truth cropped to {}..{} s (evo's --t_start/--t_end): {} of {} poses", lo,
+                  hi, kept.size(), gt.size());
+  gt = std::move(kept);
+  return note;
+}
+
+}  // namespace
+
 const RpeResult* find_rpe(const EvalResult& result, std::string_view kind) {
   for (const RpeResult& r : result.rpe) {
     if (r.kind == kind) return &r;
@@ -303,6 +342,18 @@ EvalResult evaluate(Trajectory gt, Trajectory est, const EvalOptions& opt) {
         fmt::format("association '{}' needs stamps on both trajectories; KITTI files "
                     "without a times file pair by index",
                     to_string(res.association)));
+  }
+  if ((opt.t_start || opt.t_end || opt.t_offset != 0.0) && !res.has_stamps) {
+    throw Error("--t-start, --t-end and --t-offset need stamps on both trajectories");
+  }
+  if (opt.t_start || opt.t_end) res.notes.push_back(crop_to_time_range(gt, opt));
+  if (opt.t_offset != 0.0) {
+    res.notes.push_back(fmt::format("{:g} s added to the estimate's stamps", opt.t_offset));
+    // Under evo's pairing the offset is applied in evo's float64 seconds (below).
+    if (!(opt.convention == Convention::evo && res.association == Association::nearest)) {
+      const Time offset = Time::from_seconds(opt.t_offset);
+      for (Time& t : est.stamps) t = t + offset;
+    }
   }
   const std::string overlap =
       gt.has_stamps && est.has_stamps
@@ -393,7 +444,8 @@ EvalResult evaluate(Trajectory gt, Trajectory est, const EvalOptions& opt) {
     Matches m;
     if (res.association == Association::nearest && opt.convention == Convention::evo) {
       m = associate_evo_seconds(evo_seconds(gt.stamps, opt.gt_stamps_ns),
-                                evo_seconds(est.stamps, opt.est_stamps_ns), opt.max_diff.seconds());
+                                evo_seconds(est.stamps, opt.est_stamps_ns), opt.max_diff.seconds(),
+                                opt.t_offset);
       res.notes.push_back(fmt::format(
           "each stamp of the shorter trajectory takes the nearest of the longer within {} s, in "
           "float64 seconds as evo reads them, the first of equal stamps (evo's rule, not "
@@ -472,7 +524,7 @@ EvalResult evaluate(Trajectory gt, Trajectory est, const EvalOptions& opt) {
           "VBR: segments of 1, 2, 3, 5, 8, 13, 21, 34, 55 % of the GT length, every frame a start",
           m_gt, m_est, lengths, 1, keep));
       res.rpe.push_back(make_rpe("delta", delta_definition(opt),
-                                 delta_errors(m_gt, m_est, delta_pairs(m_est, opt)),
+                                 delta_errors(m_gt, m_est, delta_pairs(m_gt, m_est, opt)),
                                  keep || opt.keep_per_pose));
       res.notes.push_back(
           "rigcal: rotations re-orthonormalised; ATE is the true RMSE; RPE pooled over segments");
@@ -480,7 +532,7 @@ EvalResult evaluate(Trajectory gt, Trajectory est, const EvalOptions& opt) {
     }
     case Convention::evo:
       res.rpe.push_back(make_rpe("delta", "evo_rpe: " + delta_definition(opt) + ", E = inv(dQ) dP",
-                                 delta_errors(m_gt, m_est, delta_pairs(m_est, opt)),
+                                 delta_errors(m_gt, m_est, delta_pairs(m_gt, m_est, opt)),
                                  keep || opt.keep_per_pose));
       res.notes.push_back(
           "evo: APE and RPE as evo_ape / evo_rpe compute them; rotation angles from the log map");

@@ -34,8 +34,17 @@ struct EvalOptions {
   Time max_diff = Time::from_ns(10'000'000);  // nearest / one-to-one: 10 ms (evo's default)
   Time max_gap = Time::from_ns(500'000'000);  // interpolate: longest GT interval bridged, 0.5 s
   double delta = 1;                           // evo-style RPE delta ...
-  DeltaUnit delta_unit = DeltaUnit::frames;   // ... in frames or metres
+  DeltaUnit delta_unit = DeltaUnit::frames;   // ... in frames, metres, degrees or radians
   bool all_pairs = false;                     // evo's --all_pairs
+  double delta_tol = 0.1;                     // evo's --delta_tol: relative, all pairs in m/deg/rad
+  bool pairs_from_reference = false;          // evo's --pairs_from_reference: pairs on the GT
+  // evo's --t_offset: seconds added to the estimate's stamps before association (under the evo
+  // convention in evo's arithmetic: to the longer trajectory's float64 seconds, negated for the
+  // ground truth).
+  double t_offset = 0;
+  // evo's --t_start / --t_end: only ground-truth poses whose stamps (as float64 seconds) are
+  // within [t_start, t_end] are associated; the estimate is not cropped.
+  std::optional<double> t_start, t_end;
   // Per matched pose (stamps, positions, ATE errors) and the delta kind's pairs: the report's
   // plots, a few tens of MB for a million poses.
   bool keep_per_pose = false;

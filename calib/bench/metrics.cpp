@@ -112,10 +112,14 @@ std::vector<double> evo_seconds(const std::vector<Time>& stamps, bool read_as_ns
   return out;
 }
 
-Matches associate_evo_seconds(const std::vector<double>& gt_seconds,
-                              const std::vector<double>& est_seconds, double max_diff) {
+Matches associate_evo_seconds(std::vector<double> gt_seconds, std::vector<double> est_seconds,
+                              double max_diff, double est_offset) {
   Matches m;
   const bool est_longer = est_seconds.size() > gt_seconds.size();
+  if (est_offset != 0.0) {
+    for (double& s : est_longer ? est_seconds : gt_seconds)
+      s += est_longer ? est_offset : -est_offset;
+  }
   const auto pairs = est_longer ? nearest_seconds(gt_seconds, est_seconds, max_diff)
                                 : nearest_seconds(est_seconds, gt_seconds, max_diff);
   for (const auto& [short_i, long_i] : pairs) {
@@ -366,11 +370,87 @@ std::vector<Segment> length_segments(const std::vector<SE3>& T_world_gt,
   return segments;
 }
 
-std::vector<std::pair<size_t, size_t>> evo_delta_pairs(const std::vector<SE3>& T_world_est,
-                                                       double delta, DeltaUnit unit,
-                                                       bool all_pairs) {
+DeltaUnit delta_unit_from_string(std::string_view name) {
+  if (name == "f" || name == "frames") return DeltaUnit::frames;
+  if (name == "m" || name == "meters") return DeltaUnit::meters;
+  if (name == "d" || name == "deg" || name == "degrees") return DeltaUnit::degrees;
+  if (name == "r" || name == "rad" || name == "radians") return DeltaUnit::radians;
+  throw Error(fmt::format(
+      "unknown delta unit '{}'; expected f (frames), m (metres), d (degrees) or r (radians)",
+      name));
+}
+
+std::string_view to_string(DeltaUnit unit) {
+  switch (unit) {
+    case DeltaUnit::frames:
+      return "frames";
+    case DeltaUnit::meters:
+      return "m";
+    case DeltaUnit::degrees:
+      return "deg";
+    case DeltaUnit::radians:
+      return "rad";
+  }
+  return "?";
+}
+
+namespace {
+
+// evo's filter_pairs_by_path with all_pairs: for each i, numpy's argmin over j > i of
+// |(dist[j] - dist[i]) - delta|. The differences grow with j, so the smallest is at the first j
+// whose path reaches delta or at the one before it, and a tie goes to the first of equal paths.
+std::vector<std::pair<size_t, size_t>> all_pairs_by_path(const std::vector<double>& dist,
+                                                         double delta, double tol) {
   std::vector<std::pair<size_t, size_t>> pairs;
-  const size_t n = T_world_est.size();
+  const size_t n = dist.size();
+  for (size_t i = 0; i + 1 < n; ++i) {
+    const double d0 = dist[i];
+    const auto reach = [&](double d) { return (d - d0) - delta; };
+    size_t k = static_cast<size_t>(
+        std::partition_point(dist.begin() + static_cast<std::ptrdiff_t>(i + 1), dist.end(),
+                             [&](double d) { return reach(d) < 0.0; }) -
+        dist.begin());
+    if (k > i + 1 && (k == n || std::abs(reach(dist[k - 1])) <= std::abs(reach(dist[k])))) {
+      const double below = reach(dist[k - 1]);  // the first path that rounds to the same
+      k = static_cast<size_t>(
+          std::partition_point(dist.begin() + static_cast<std::ptrdiff_t>(i + 1),
+                               dist.begin() + static_cast<std::ptrdiff_t>(k - 1),
+                               [&](double d) { return reach(d) < below; }) -
+          dist.begin());
+    }
+    if (std::abs(reach(dist[k])) <= tol) pairs.emplace_back(i, k);
+  }
+  return pairs;
+}
+
+// evo's filter_pairs_by_angle with all_pairs: every later pose whose relative rotation's angle
+// is within [delta - tol, delta + tol] rad. Quadratic, as evo's; rows in parallel.
+std::vector<std::pair<size_t, size_t>> all_pairs_by_angle(const std::vector<SE3>& poses,
+                                                          double delta, double tol) {
+  const size_t n = poses.size();
+  std::vector<std::vector<size_t>> ends(n);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 16), [&](const auto& r) {
+    for (size_t i = r.begin(); i < r.end(); ++i) {
+      const Eigen::Matrix3d Rt = poses[i].R.transpose();
+      for (size_t j = i + 1; j < n; ++j) {
+        const double angle = rotation_angle(Rt * poses[j].R);
+        if (delta - tol <= angle && angle <= delta + tol) ends[i].push_back(j);
+      }
+    }
+  });
+  std::vector<std::pair<size_t, size_t>> pairs;
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j : ends[i]) pairs.emplace_back(i, j);
+  return pairs;
+}
+
+}  // namespace
+
+std::vector<std::pair<size_t, size_t>> evo_delta_pairs(const std::vector<SE3>& T_world_body,
+                                                       double delta, DeltaUnit unit, bool all_pairs,
+                                                       double rel_tol) {
+  std::vector<std::pair<size_t, size_t>> pairs;
+  const size_t n = T_world_body.size();
   if (!(delta > 0)) throw Error("the RPE delta must be positive");
   if (unit == DeltaUnit::frames) {
     const size_t d = static_cast<size_t>(delta);
@@ -378,49 +458,35 @@ std::vector<std::pair<size_t, size_t>> evo_delta_pairs(const std::vector<SE3>& T
     for (size_t i = 0; i + d < n; i += all_pairs ? 1 : d) pairs.emplace_back(i, i + d);
     return pairs;
   }
-  const std::vector<double> dist = cumulative_distances(T_world_est);
-  if (!all_pairs) {
+  if (unit == DeltaUnit::meters) {
+    if (all_pairs)
+      return all_pairs_by_path(cumulative_distances(T_world_body), delta, delta * rel_tol);
     std::vector<size_t> ids;
     double path = 0.0;
     for (size_t i = 1; i < n; ++i) {
-      path += (T_world_est[i].t - T_world_est[i - 1].t).norm();
+      path += (T_world_body[i].t - T_world_body[i - 1].t).norm();
       if (path >= delta) ids.push_back(i), path = 0.0;
     }
     for (size_t k = 0; k + 1 < ids.size(); ++k) pairs.emplace_back(ids[k], ids[k + 1]);
     return pairs;
   }
-  // evo's bounded_binary_search over j in [0, n) of the path length from i to j (0 for j < i).
-  const double lower = 0.9 * delta, upper = 1.1 * delta;
-  for (size_t i = 0; i < n; ++i) {
-    auto path = [&](long j) {
-      if (j <= static_cast<long>(i)) return 0.0;
-      return dist[std::min<size_t>(static_cast<size_t>(j), n - 1)] - dist[i];
-    };
-    long start = 0, end = static_cast<long>(n) - 1, mid = -1;
-    bool found = false;
-    while (start <= end && !found) {
-      mid = (start + end) / 2;
-      const double val = path(mid);
-      if (lower <= val && val <= upper) {
-        const double residual = std::abs(val - delta);
-        if (std::abs(path(mid - 1) - delta) <= residual) {
-          end = mid - 1;
-          continue;
-        }
-        if (std::abs(path(mid + 1) - delta) < residual) {
-          start = mid + 1;
-          continue;
-        }
-        found = true;
-      }
-      if (!found) {
-        if (delta < val)
-          end = mid - 1;
-        else
-          start = mid + 1;
-      }
+  const bool degrees = unit == DeltaUnit::degrees;
+  if (delta > (degrees ? 180.0 : M_PI)) {
+    throw Error(fmt::format("an angle delta must be within [0, {}] {}", degrees ? "180" : "pi",
+                            to_string(unit)));
+  }
+  const double delta_rad = degrees ? delta * (M_PI / 180.0) : delta;  // numpy's deg2rad
+  const double tol_rad = degrees ? (delta * rel_tol) * (M_PI / 180.0) : delta * rel_tol;
+  if (all_pairs) return all_pairs_by_angle(T_world_body, delta_rad, tol_rad);
+  double accumulated = 0.0;
+  size_t start = 0;
+  for (size_t i = 0; i + 1 < n; ++i) {
+    accumulated += rotation_angle(T_world_body[i].R.transpose() * T_world_body[i + 1].R);
+    if (accumulated >= delta_rad) {
+      pairs.emplace_back(start, i + 1);
+      accumulated = 0.0;
+      start = i + 1;
     }
-    if (found) pairs.emplace_back(i, static_cast<size_t>(mid));
   }
   return pairs;
 }

@@ -40,8 +40,9 @@ std::vector<std::pair<size_t, size_t>> nearest_seconds(const std::vector<double>
 // The float64 seconds evo reads: the decimal seconds correctly rounded (TUM: the text through
 // float()), or integer nanoseconds read as float64 then divided by 1e9 (EuRoC).
 std::vector<double> evo_seconds(const std::vector<Time>& stamps, bool read_as_ns);
-Matches associate_evo_seconds(const std::vector<double>& gt_seconds,
-                              const std::vector<double>& est_seconds, double max_diff);
+// est_offset (evo's --t_offset) is added to the longer one's seconds, negated for the ground truth.
+Matches associate_evo_seconds(std::vector<double> gt_seconds, std::vector<double> est_seconds,
+                              double max_diff, double est_offset = 0.0);
 // One-to-one (TUM associate.py): all pairs within max_diff, taken greedily by increasing |dt|.
 Matches associate_one_to_one(const Trajectory& gt, const Trajectory& est, Time max_diff);
 // By index, for files without stamps: the first min(N, M) poses.
@@ -99,15 +100,21 @@ void for_each_length_segment(const std::vector<SE3>& T_world_gt,
 std::vector<Segment> length_segments(const std::vector<SE3>& T_world_gt,
                                      const std::vector<SE3>& T_world_est,
                                      const std::vector<double>& lengths, size_t step);
-// evo's RPE pairs, chosen on the estimate's poses (evo's default):
+// evo's RPE pairs (evo.core.filters, 1.36.5), chosen on the poses given (the estimate's by
+// default, the reference's with evo's --pairs_from_reference):
 //   frames, consecutive: (0, d), (d, 2d), ...; all pairs: (i, i + d) for every i.
-//   metres, consecutive: the poses where the estimate's path since the previous one reaches d;
-//   metres, all pairs: for each i, evo's bounded binary search for the j whose path length from i
-//   is nearest d within d +- 10 %.
-enum class DeltaUnit { frames, meters };
-std::vector<std::pair<size_t, size_t>> evo_delta_pairs(const std::vector<SE3>& T_world_est,
-                                                       double delta, DeltaUnit unit,
-                                                       bool all_pairs);
+//   metres, consecutive: the poses where the path since the previous one reaches d;
+//   metres, all pairs: for each i, the first j > i whose path length from i is nearest d
+//   (numpy's argmin), kept when within d * rel_tol of d.
+//   degrees / radians, consecutive: the poses where the sum of the angles between consecutive
+//   rotations since the previous one reaches d; all pairs: every (i, j > i) whose relative
+//   rotation's angle is within d * rel_tol of d (quadratic in the poses, as in evo).
+enum class DeltaUnit { frames, meters, degrees, radians };
+DeltaUnit delta_unit_from_string(std::string_view name);  // f | m | d | r (evo's letters)
+std::string_view to_string(DeltaUnit unit);               // frames | m | deg | rad
+std::vector<std::pair<size_t, size_t>> evo_delta_pairs(const std::vector<SE3>& T_world_body,
+                                                       double delta, DeltaUnit unit, bool all_pairs,
+                                                       double rel_tol = 0.1);
 // E = inv(dQ) * dP for each pair (the inverse of the KITTI form; same norms); `length` is the GT
 // path between the two poses.
 std::vector<Segment> delta_errors(const std::vector<SE3>& T_world_gt,

@@ -44,14 +44,17 @@ EvalOptions eval_options(const BenchOptions& o) {
   e.max_diff = Time::from_seconds(o.max_diff);
   e.max_gap = Time::from_seconds(o.max_gap);
   e.delta = o.delta;
-  if (o.delta_unit == "f" || o.delta_unit == "frames")
-    e.delta_unit = DeltaUnit::frames;
-  else if (o.delta_unit == "m" || o.delta_unit == "meters")
-    e.delta_unit = DeltaUnit::meters;
-  else
-    throw Error(
-        fmt::format("--delta-unit: expected f (frames) or m (metres), got '{}'", o.delta_unit));
+  try {
+    e.delta_unit = delta_unit_from_string(o.delta_unit);
+  } catch (const Error& err) {
+    throw Error(fmt::format("--delta-unit: {}", err.what()));
+  }
   e.all_pairs = o.all_pairs;
+  e.delta_tol = o.delta_tol;
+  e.pairs_from_reference = o.pairs_from_reference;
+  e.t_offset = o.t_offset;
+  e.t_start = o.t_start;
+  e.t_end = o.t_end;
   e.keep_per_pose = !o.report.empty();
   e.keep_segments = !o.report.empty() && o.per_pose;
   if (o.per_pose && o.report.empty()) throw Error("--per-pose writes beside --report DIR: give it");

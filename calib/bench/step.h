@@ -3,6 +3,7 @@
 // leaderboard of methods over sequences, from files, with the report written where asked. The
 // command line only parses options into BenchOptions and prints the lines returned.
 #include <functional>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -23,6 +24,10 @@ struct BenchOptions {
   double delta = 1;
   std::string delta_unit = "f";
   bool all_pairs = false;
+  double delta_tol = 0.1;                // evo's --delta_tol
+  bool pairs_from_reference = false;     // evo's --pairs_from_reference
+  double t_offset = 0;                   // evo's --t_offset, s
+  std::optional<double> t_start, t_end;  // evo's --t_start / --t_end, s
   double max_diff = 0.01, max_gap = 0.5;
   std::string duplicates;
   std::string plot_mode = "auto";  // --plot-mode

@@ -389,6 +389,19 @@ TEST_F(Cli, BenchPrintsTableWritesReportAndRefusesBadFiles) {
   r = run("bench --gt " + gt.string());
   EXPECT_EQ(r.status, 2);
   EXPECT_EQ(r.err, "rigcal: error: give --gt and --est (or --gt-dir and --est-dir)\n");
+  // A time window without ground truth in it, and one the wrong way round.
+  r = run("bench --gt " + gt.string() + " --est " + est.string() + " --t-start 5000");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("no ground-truth pose between --t-start and --t-end"), std::string::npos)
+      << r.err;
+  r = run("bench --gt " + gt.string() + " --est " + est.string() + " --t-start 9 --t-end 3");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--t-start 9 s is after --t-end 3 s"), std::string::npos) << r.err;
+  r = run("bench --gt " + gt.string() + " --est " + est.string() + " --delta-unit x");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("expected f (frames), m (metres), d (degrees) or r (radians)"),
+            std::string::npos)
+      << r.err;
   r = run("bench --gt " + gt.string() + " --est " + est.string() + " --convention foo");
   EXPECT_EQ(r.status, 2);
   EXPECT_EQ(r.err, "rigcal: error: unknown convention 'foo'; expected rigcal, evo, kitti or vbr\n");
@@ -444,6 +457,10 @@ TEST_F(Cli, BenchKittiPosesDrawInTheirPlaneAndRowsOnlyWhenAsked) {
   r = run("bench --gt " + gt.string() + " --est " + est.string() + " --per-pose");
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("--per-pose"), std::string::npos) << r.err;
+  // evo's time options need stamps; rows paired by index have none.
+  r = run("bench --gt " + gt.string() + " --est " + est.string() + " --t_offset 0.1");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("need stamps on both trajectories"), std::string::npos) << r.err;
 }
 
 // Several estimates against one ground truth, then the saved results compared (evo_res): one
