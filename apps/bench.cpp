@@ -1,5 +1,6 @@
 // rigcal bench: scores estimated trajectories against ground truth (doc/bench.md).
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <filesystem>
 #include <memory>
@@ -24,8 +25,10 @@ void run_several(const bench::BenchOptions& o) {
 }
 
 void run_compare(const std::vector<std::string>& results, const std::string& report) {
-  fmt::print("{}", bench::compare_markdown(bench::compare_results(results, report)));
-  if (!report.empty()) fmt::print("report: {}/compare.md (.csv, .json), compare_ate.svg\n", report);
+  const bench::Compared compared = bench::compare_results(results, report);
+  fmt::print("{}", bench::compare_markdown(compared.results));
+  if (!report.empty())
+    fmt::print("report: {}: {}\n", report, fmt::join(compared.report_files, ", "));
 }
 
 void run_leaderboard(const bench::BenchOptions& o) {
@@ -137,11 +140,14 @@ void add_bench(CLI::App& app) {
   CLI::App* compare = cmd->add_subcommand(
       "compare",
       "Compare saved results (evo_res's job): a table of their figures (ATE statistics, each\n"
-      "RPE kind) and a plot of their ATE. RESULT: a bench.json, or the --report folder holding\n"
+      "RPE kind) and evo_res's plots. RESULT: a bench.json, or the --report folder holding\n"
       "one; a result is named by its folder.");
   compare->add_option("results", *compared, "RESULT...")->required();
-  compare->add_option("--report", *compare_report,
-                      "folder for compare.md, compare.csv, compare.json, compare_ate.svg");
+  compare->add_option(
+      "--report", *compare_report,
+      "folder for compare.md, .csv, .json and evo_res's plots: the ATE's and the delta\n"
+      "RPE's statistics as bars; box plots and histograms where the results\n"
+      "hold their distribution (bench --report writes it)");
   compare->callback([compared, compare_report] { run_compare(*compared, *compare_report); });
   cmd->callback([o, compare] {
     if (compare->parsed()) return;

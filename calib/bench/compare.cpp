@@ -45,13 +45,20 @@ std::vector<Column> columns(const std::vector<NamedResult>& results) {
   return out;
 }
 
-const nlohmann::json* at(const nlohmann::json& j, const std::vector<std::string>& path) {
+// A node of a summary by its path, or null.
+const nlohmann::json* node_at(const nlohmann::json& j, const std::vector<std::string>& path) {
   const nlohmann::json* node = &j;
   for (const std::string& key : path) {
     if (!node->is_object() || !node->contains(key)) return nullptr;
     node = &(*node)[key];
   }
-  return node->is_number() ? node : nullptr;
+  return node;
+}
+
+// A number of a summary by its path, or null.
+const nlohmann::json* at(const nlohmann::json& j, const std::vector<std::string>& path) {
+  const nlohmann::json* node = node_at(j, path);
+  return node && node->is_number() ? node : nullptr;
 }
 
 std::string cell(const nlohmann::json& summary, const Column& c) {
@@ -152,29 +159,91 @@ nlohmann::json compare_json(const std::vector<NamedResult>& results) {
   return j;
 }
 
-void write_compare_report(const std::vector<NamedResult>& results, const fs::path& dir) {
-  report::Plot plot;
-  plot.title = "ATE (translation) of each result: rmse, and mean +- std";
-  plot.x_label = "result (in the table's order)";
-  plot.y_label = "ATE [m]";
-  report::PlotSeries rmse{"rmse", {}, {}, {}}, mean{"mean +- std", {}, {}, {}};
-  rmse.points = mean.points = true;
-  for (size_t i = 0; i < results.size(); ++i) {
-    const nlohmann::json& s = results[i].summary;
-    const nlohmann::json *r = at(s, {"ate", "trans", "rmse"}), *m = at(s, {"ate", "trans", "mean"}),
-                         *sd = at(s, {"ate", "trans", "std"});
-    if (r) rmse.x.push_back(static_cast<double>(i + 1)), rmse.y.push_back(r->get<double>());
-    if (m && sd) {
-      mean.x.push_back(static_cast<double>(i + 1) + 0.15);
-      mean.y.push_back(m->get<double>());
-      mean.y_error.push_back(sd->get<double>());
+namespace {
+
+// evo_res's three views of one metric across the results, from their summaries: the statistics
+// as grouped bars, and, for the results whose summary holds the distribution (written with the
+// report), box plots and density histograms. Files named <prefix>_{stats,box,histogram}.svg.
+std::vector<io::OutputFile> metric_plots(const std::vector<NamedResult>& results,
+                                         const std::vector<std::string>& path,
+                                         const std::string& metric, const fs::path& prefix) {
+  std::vector<io::OutputFile> files;
+  const char* stat_names[] = {"rmse", "mean", "median", "std", "min", "max"};
+  const double group = 1.0, bar = 0.8 * group / static_cast<double>(results.size());
+  report::Plot stats;
+  stats.title = fmt::format("{}: statistics of each result", metric);
+  stats.y_label = metric;
+  for (size_t s = 0; s < std::size(stat_names); ++s)
+    stats.x_ticks.emplace_back(static_cast<double>(s), stat_names[s]);
+  report::Plot box;
+  box.title = fmt::format("{}: quartiles, whiskers at 1.5 IQR", metric);
+  box.y_label = metric;
+  report::Plot hist;
+  hist.title = fmt::format("{}: distribution of each result", metric);
+  hist.x_label = metric;
+  hist.y_label = "density";
+  bool any_stats = false, any_distribution = false;
+  for (size_t k = 0; k < results.size(); ++k) {
+    const nlohmann::json* node = node_at(results[k].summary, path);
+    report::PlotSeries bars{results[k].name, {}, {}, {}};
+    bars.bars = true;
+    bars.width = bar;
+    for (size_t s = 0; node && s < std::size(stat_names); ++s) {
+      if (!node->contains(stat_names[s]) || !(*node)[stat_names[s]].is_number()) continue;
+      bars.x.push_back(static_cast<double>(s) - 0.4 * group + (static_cast<double>(k) + 0.5) * bar);
+      bars.y.push_back((*node)[stat_names[s]].get<double>());
     }
+    any_stats = any_stats || !bars.x.empty();
+    stats.series.push_back(std::move(bars));
+    box.x_ticks.emplace_back(static_cast<double>(k), results[k].name);
+    report::PlotSeries b{results[k].name, {}, {}, {}}, h{results[k].name, {}, {}, {}};
+    b.width = 0.5;
+    h.bars = true;
+    const nlohmann::json* d = node ? node_at(*node, {"distribution"}) : nullptr;
+    if (d && d->contains("counts") && d->value("n", 0) > 0) {
+      any_distribution = true;
+      b.x.push_back(static_cast<double>(k));
+      b.boxes.push_back({d->value("whisker_low", 0.0), d->value("q1", 0.0), d->value("median", 0.0),
+                         d->value("q3", 0.0), d->value("whisker_high", 0.0)});
+      const double low = d->value("bin_low", 0.0), width = d->value("bin_width", 1.0);
+      const double n = d->value("n", 1.0);
+      h.width = width;
+      const std::vector<double> counts = (*d)["counts"].get<std::vector<double>>();
+      for (size_t i = 0; i < counts.size(); ++i) {
+        h.x.push_back(low + (static_cast<double>(i) + 0.5) * width);
+        h.y.push_back(counts[i] / (n * width));
+      }
+    }
+    box.series.push_back(std::move(b));
+    hist.series.push_back(std::move(h));
   }
-  plot.series = {rmse, mean};
-  io::write_files_atomic({{dir / "compare.md", compare_markdown(results)},
-                          {dir / "compare.csv", compare_csv(results)},
-                          {dir / "compare.json", report::json_text(compare_json(results))},
-                          {dir / "compare_ate.svg", report::render_svg(plot)}});
+  if (!any_stats) return files;
+  files.push_back({fs::path(prefix.string() + "_stats.svg"), report::render_svg(stats)});
+  if (any_distribution) {
+    files.push_back({fs::path(prefix.string() + "_box.svg"), report::render_svg(box)});
+    files.push_back({fs::path(prefix.string() + "_histogram.svg"), report::render_svg(hist)});
+  }
+  return files;
+}
+
+}  // namespace
+
+std::vector<std::string> write_compare_report(const std::vector<NamedResult>& results,
+                                              const fs::path& dir) {
+  std::vector<io::OutputFile> files = {
+      {dir / "compare.md", compare_markdown(results)},
+      {dir / "compare.csv", compare_csv(results)},
+      {dir / "compare.json", report::json_text(compare_json(results))}};
+  for (auto& f :
+       metric_plots(results, {"ate", "trans"}, "ATE translation [m]", dir / "compare_ate"))
+    files.push_back(std::move(f));
+  for (auto& f : metric_plots(results, {"rpe", "delta", "trans"},
+                              "RPE (delta pairs) translation [m]", dir / "compare_rpe"))
+    files.push_back(std::move(f));
+  io::write_files_atomic(files);
+  std::vector<std::string> names;
+  for (const io::OutputFile& f : files) names.push_back(f.path.filename().string());
+  return names;
 }
 
 void write_overlay_plots(const std::vector<const EvalResult*>& results,

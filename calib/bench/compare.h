@@ -30,10 +30,13 @@ void make_names_unique(std::vector<NamedResult>& results);
 std::string compare_markdown(const std::vector<NamedResult>& results);
 std::string compare_csv(const std::vector<NamedResult>& results);
 nlohmann::json compare_json(const std::vector<NamedResult>& results);
-// DIR/compare.{md,csv,json} and DIR/compare_ate.svg (each result's ATE rmse, and mean +- std as
-// a bar).
-void write_compare_report(const std::vector<NamedResult>& results,
-                          const std::filesystem::path& dir);
+// DIR/compare.{md,csv,json} and evo_res's plots of the ATE translation and of the delta pairs'
+// RPE translation: compare_{ate,rpe}_stats.svg (rmse, mean, median, std, min, max as grouped
+// bars) and, for results whose bench.json holds the errors' distribution (written with
+// --report), compare_{ate,rpe}_box.svg and compare_{ate,rpe}_histogram.svg. Returns the names of
+// the files written.
+std::vector<std::string> write_compare_report(const std::vector<NamedResult>& results,
+                                              const std::filesystem::path& dir);
 
 // Several estimates against one ground truth, evaluated with keep_per_pose: DIR/trajectories.svg
 // (the ground truth and every aligned estimate, in the ground truth's plane) and DIR/ate.svg

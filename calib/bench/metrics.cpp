@@ -39,6 +39,51 @@ Stats statistics(std::vector<double> values) {
   return s;
 }
 
+Distribution distribution(std::vector<double> values) {
+  Distribution d;
+  d.n = values.size();
+  if (values.empty()) return d;
+  const auto [lo_it, hi_it] = std::minmax_element(values.begin(), values.end());
+  const double lo = *lo_it, hi = *hi_it;
+  // numpy's percentile ('linear'): at position q (n - 1), between the order statistics around it.
+  auto quantile = [&](double q) {
+    const double pos = q * static_cast<double>(values.size() - 1);
+    const size_t k = static_cast<size_t>(pos);
+    const auto at = values.begin() + static_cast<std::ptrdiff_t>(k);
+    std::nth_element(values.begin(), at, values.end());
+    const double below = *at;
+    if (k + 1 >= values.size()) return below;
+    const double above = *std::min_element(at + 1, values.end());
+    return below + (pos - static_cast<double>(k)) * (above - below);
+  };
+  d.q1 = quantile(0.25);
+  d.median = quantile(0.5);
+  d.q3 = quantile(0.75);
+  const double iqr = d.q3 - d.q1, reach_low = d.q1 - 1.5 * iqr, reach_high = d.q3 + 1.5 * iqr;
+  d.whisker_low = d.q1;
+  d.whisker_high = d.q3;
+  for (double v : values) {
+    if (v >= reach_low) d.whisker_low = std::min(d.whisker_low, v);
+    if (v <= reach_high) d.whisker_high = std::max(d.whisker_high, v);
+  }
+  const double n = static_cast<double>(values.size());
+  size_t bins = 1;
+  if (hi > lo) {
+    const double h = 2.0 * iqr / std::cbrt(n);
+    bins = h > 0 ? static_cast<size_t>(std::ceil((hi - lo) / h))
+                 : static_cast<size_t>(std::ceil(std::sqrt(n)));
+    bins = std::clamp<size_t>(bins, 1, 50);
+  }
+  d.bin_low = lo;
+  d.bin_width = hi > lo ? (hi - lo) / static_cast<double>(bins) : 1.0;
+  d.counts.assign(bins, 0);
+  for (double v : values) {
+    const double f = (v - lo) / d.bin_width;
+    ++d.counts[std::min(bins - 1, static_cast<size_t>(std::max(0.0, f)))];
+  }
+  return d;
+}
+
 std::vector<std::pair<size_t, size_t>> nearest_stamps(const std::vector<Time>& a,
                                                       const std::vector<Time>& b, Time max_diff) {
   std::vector<std::pair<size_t, size_t>> pairs;

@@ -18,6 +18,18 @@ struct Stats {
 // segment errors are not copied).
 Stats statistics(std::vector<double> values);
 
+// The shape of a set of errors, for box plots and histograms (evo_res's): quartiles by linear
+// interpolation between order statistics (numpy's percentile), whiskers at the furthest values
+// within 1.5 interquartile ranges of the box (matplotlib's), and a histogram over [min, max] of
+// Freedman-Diaconis bins (2 IQR / n^(1/3) wide), at most 50 (sqrt(n) when the IQR is 0). O(n).
+struct Distribution {
+  size_t n = 0;
+  double q1 = 0, median = 0, q3 = 0, whisker_low = 0, whisker_high = 0;
+  double bin_low = 0, bin_width = 0;  // bin k covers [bin_low + k w, bin_low + (k + 1) w)
+  std::vector<size_t> counts;         // the last bin includes the maximum
+};
+Distribution distribution(std::vector<double> values);
+
 // ---- association --------------------------------------------------------------------------------
 struct Matches {
   std::vector<size_t> gt, est;  // pairs: gt[k] with est[k]

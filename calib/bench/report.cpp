@@ -22,6 +22,18 @@ nlohmann::json stats_json(const Stats& s) {
           {"std", s.std}, {"min", s.min},   {"max", s.max},   {"sse", s.sse}};
 }
 
+nlohmann::json distribution_json(const Distribution& d) {
+  return {{"n", d.n},
+          {"q1", d.q1},
+          {"median", d.median},
+          {"q3", d.q3},
+          {"whisker_low", d.whisker_low},
+          {"whisker_high", d.whisker_high},
+          {"bin_low", d.bin_low},
+          {"bin_width", d.bin_width},
+          {"counts", d.counts}};
+}
+
 // JSON has no infinity: failed entries become null.
 nlohmann::json number_or_null(bool ok, double v) {
   return ok && std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
@@ -92,6 +104,8 @@ nlohmann::json bench_json(const EvalResult& r, const std::map<std::string, std::
                 {"n_used", r.alignment.n_used}};
   j["ate"]["trans"] = stats_json(r.ate_trans);
   j["ate"]["rot"] = stats_json(r.ate_rot_deg);
+  if (!r.ate_trans_errors.empty())
+    j["ate"]["trans"]["distribution"] = distribution_json(distribution(r.ate_trans_errors));
   if (r.vbr_ate_trans) {
     j["ate"]["trans"]["vbr_sqrt_mean"] = *r.vbr_ate_trans;
     j["ate"]["rot"]["vbr_sqrt_mean"] = *r.vbr_ate_rot;
@@ -108,6 +122,12 @@ nlohmann::json bench_json(const EvalResult& r, const std::map<std::string, std::
     if (rpe.trans.n > 0) {
       k["trans"] = stats_json(rpe.trans);
       k["rot"] = stats_json(rpe.rot_deg);
+    }
+    if (rpe.kind == "delta" && !rpe.segments.empty()) {
+      std::vector<double> trans;
+      trans.reserve(rpe.segments.size());
+      for (const Segment& seg : rpe.segments) trans.push_back(seg.trans);
+      k["trans"]["distribution"] = distribution_json(distribution(std::move(trans)));
     }
     j["rpe"][rpe.kind] = k;
   }

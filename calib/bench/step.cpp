@@ -1,6 +1,7 @@
 #include "rigcal/bench/step.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <cmath>
 #include <filesystem>
@@ -170,8 +171,9 @@ SeveralRun score_several(const BenchOptions& o) {
       results.push_back(&out.runs[k].result);
       names.push_back(out.named[k].name);
     }
-    write_compare_report(out.named, dir);
+    out.report_files = write_compare_report(out.named, dir);
     write_overlay_plots(results, names, dir, plot_mode_from_string(o.plot_mode));
+    out.report_files.insert(out.report_files.end(), {"trajectories.svg", "ate.svg"});
   }
   return out;
 }
@@ -188,22 +190,19 @@ std::vector<std::string> several_summary(const BenchOptions& o, const SeveralRun
   out.push_back("");
   out.push_back(compare_markdown(run.named));
   if (!o.report.empty()) {
-    out.push_back(fmt::format(
-        "report: {0}/compare.md (.csv, .json), compare_ate.svg, trajectories.svg, ate.svg, and "
-        "each estimate's in {0}/<name>/",
-        o.report));
+    out.push_back(fmt::format("report: {0}: {1}; each estimate's in {0}/<name>/", o.report,
+                              fmt::join(run.report_files, ", ")));
   }
   return out;
 }
 
-std::vector<NamedResult> compare_results(const std::vector<std::string>& paths,
-                                         const std::string& report) {
+Compared compare_results(const std::vector<std::string>& paths, const std::string& report) {
   if (paths.empty()) throw Error("give the results to compare: bench.json files or their folders");
-  std::vector<NamedResult> results;
-  for (const std::string& p : paths) results.push_back(read_result(p));
-  make_names_unique(results);
-  if (!report.empty()) write_compare_report(results, report);
-  return results;
+  Compared out;
+  for (const std::string& p : paths) out.results.push_back(read_result(p));
+  make_names_unique(out.results);
+  if (!report.empty()) out.report_files = write_compare_report(out.results, report);
+  return out;
 }
 
 Leaderboard score_leaderboard(const BenchOptions& o,

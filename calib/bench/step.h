@@ -56,10 +56,11 @@ std::vector<std::string> pair_summary(const BenchOptions& o, const PairRun& run)
 
 // Several estimates (o.ests) against o.gt, each scored as score_pair scores one; with o.report,
 // each one's report in REPORT/<name>/ (the estimate file's stem) and, in REPORT, the comparison
-// (compare.md, .csv, .json, compare_ate.svg) and the overlay plots (trajectories.svg, ate.svg).
+// (write_compare_report's files) and the overlay plots (trajectories.svg, ate.svg).
 struct SeveralRun {
   std::vector<NamedResult> named;  // each estimate's name and summary (bench.json)
   std::vector<PairRun> runs;
+  std::vector<std::string> report_files;  // written in REPORT (each estimate's not listed)
 };
 SeveralRun score_several(const BenchOptions& o);
 // Each estimate's lines as pair_summary prints them, then the comparison table.
@@ -67,8 +68,11 @@ std::vector<std::string> several_summary(const BenchOptions& o, const SeveralRun
 
 // `rigcal bench compare RESULT...`: the saved results (bench.json files or folders holding one)
 // read, named by their folders; with `report`, the comparison written there.
-std::vector<NamedResult> compare_results(const std::vector<std::string>& paths,
-                                         const std::string& report);
+struct Compared {
+  std::vector<NamedResult> results;
+  std::vector<std::string> report_files;  // the names of the files written in `report`
+};
+Compared compare_results(const std::vector<std::string>& paths, const std::string& report);
 
 // Loads the leaderboard's folders, scores every run (`tell` receives a line per failure) and
 // writes the report when o.report is set.

@@ -64,7 +64,7 @@ Bounds bounds(const Plot& plot, double pw, double ph) {
   double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
   double v0 = x0, v1 = -x0;
   for (const PlotSeries& s : plot.series) {
-    for (size_t i = 0; i < s.x.size(); ++i) {
+    for (size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i) {  // boxes have no y
       if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
       const double e = i < s.y_error.size() && std::isfinite(s.y_error[i]) ? s.y_error[i] : 0.0;
       x0 = std::min(x0, s.x[i]), x1 = std::max(x1, s.x[i]);
@@ -73,7 +73,14 @@ Bounds bounds(const Plot& plot, double pw, double ph) {
     for (double v : s.values) {
       if (std::isfinite(v)) v0 = std::min(v0, v), v1 = std::max(v1, v);
     }
+    if (s.bars && !s.x.empty()) y0 = std::min(y0, 0.0), y1 = std::max(y1, 0.0);
+    const double half = 0.5 * s.width;
+    for (size_t i = 0; i < s.x.size() && (s.bars || !s.boxes.empty()); ++i) {
+      if (std::isfinite(s.x[i])) x0 = std::min(x0, s.x[i] - half), x1 = std::max(x1, s.x[i] + half);
+    }
+    for (const auto& b : s.boxes) y0 = std::min(y0, b[0]), y1 = std::max(y1, b[4]);
   }
+  for (const auto& [x, label] : plot.x_ticks) x0 = std::min(x0, x), x1 = std::max(x1, x);
   if (plot.grid) {
     const PlotGrid& g = *plot.grid;
     x0 = std::min(x0, g.x0), x1 = std::max(x1, g.x0 + g.cols * g.cell);
@@ -92,6 +99,11 @@ Bounds bounds(const Plot& plot, double pw, double ph) {
           4) {  // a margin, so that points on the extremes are not cut by the frame
     const double m = 0.03 * (y1 - y0);
     y0 -= m, y1 += m;
+    // Bars and boxes are drawn whole, clear of the frame.
+    const bool blocks = std::any_of(plot.series.begin(), plot.series.end(),
+                                    [](const auto& s) { return s.bars || !s.boxes.empty(); });
+    const double mx = blocks ? 0.04 * (x1 - x0) : 0.0;
+    x0 -= mx, x1 += mx;
   }
   double sx = pw / (x1 - x0), sy = ph / (y1 - y0);
   if (plot.equal_axes) {
@@ -174,11 +186,15 @@ std::string render_svg(const Plot& plot) {
                      kLeft + pw / 2, escape(plot.title));
   // Grid and ticks.
   const double xs = nice_step(x1 - x0, 8), ys = nice_step(y1 - y0, 8);
-  for (double x = std::ceil(x0 / xs) * xs; x <= x1 + 1e-9 * xs; x += xs) {
+  for (double x = std::ceil(x0 / xs) * xs; plot.x_ticks.empty() && x <= x1 + 1e-9 * xs; x += xs) {
     out += fmt::format(
         "<line x1=\"{0:.1f}\" y1=\"{1:.1f}\" x2=\"{0:.1f}\" y2=\"{2:.1f}\" stroke=\"#e0e0e0\"/>"
         "<text x=\"{0:.1f}\" y=\"{3:.1f}\" text-anchor=\"middle\">{4:g}</text>\n",
         X(x), kTop, kTop + ph, kTop + ph + 16, std::abs(x) < 1e-12 * xs ? 0.0 : x);
+  }
+  for (const auto& [x, label] : plot.x_ticks) {
+    out += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\">{}</text>\n", X(x),
+                       kTop + ph + 16, escape(label));
   }
   for (double y = std::ceil(y0 / ys) * ys; y <= y1 + 1e-9 * ys; y += ys) {
     out += fmt::format(
@@ -202,6 +218,43 @@ std::string render_svg(const Plot& plot) {
   for (size_t k = 0; k < plot.series.size(); ++k) {
     const PlotSeries& s = plot.series[k];
     const size_t stride = std::max<size_t>(1, s.x.size() / 4000);
+    const char* colour = kPalette[k % 10];
+    const double w = s.width * sx;  // in pixels
+    if (s.bars) {
+      for (size_t i = 0; i < s.x.size(); ++i) {
+        if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
+        const double ya = Y(std::max(s.y[i], 0.0)), yb = Y(std::min(s.y[i], 0.0));
+        out += fmt::format(
+            "<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"{:.1f}\" height=\"{:.1f}\" fill=\"{}\" "
+            "fill-opacity=\"0.55\" stroke=\"{}\" stroke-width=\"0.6\"/>\n",
+            X(s.x[i]) - 0.5 * w, std::min(ya, yb), w, std::abs(yb - ya), colour, colour);
+      }
+      continue;
+    }
+    if (!s.boxes.empty()) {
+      for (size_t i = 0; i < s.boxes.size() && i < s.x.size(); ++i) {
+        const auto& b = s.boxes[i];
+        const double cx = X(s.x[i]), l = cx - 0.5 * w, r = cx + 0.5 * w;
+        out += fmt::format(
+            "<line x1=\"{0:.1f}\" y1=\"{1:.1f}\" x2=\"{0:.1f}\" y2=\"{2:.1f}\" stroke=\"{5}\"/>"
+            "<line x1=\"{0:.1f}\" y1=\"{3:.1f}\" x2=\"{0:.1f}\" y2=\"{4:.1f}\" stroke=\"{5}\"/>\n",
+            cx, Y(b[0]), Y(b[1]), Y(b[3]), Y(b[4]), colour);
+        for (double y : {b[0], b[4]}) {
+          out += fmt::format(
+              "<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"{}\"/>\n",
+              cx - 0.25 * w, Y(y), cx + 0.25 * w, Y(y), colour);
+        }
+        out += fmt::format(
+            "<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"{:.1f}\" height=\"{:.1f}\" fill=\"{}\" "
+            "fill-opacity=\"0.35\" stroke=\"{}\"/>\n",
+            l, Y(b[3]), w, Y(b[1]) - Y(b[3]), colour, colour);
+        out += fmt::format(
+            "<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"{}\" "
+            "stroke-width=\"2.5\"/>\n",
+            l, Y(b[2]), r, Y(b[2]), colour);
+      }
+      continue;
+    }
     if (!s.values.empty()) {
       for (size_t i = 0; i < s.x.size(); i += stride) {
         const double f = v1 > v0 ? (s.values[i] - v0) / (v1 - v0) : 0.0;
@@ -287,10 +340,11 @@ std::string render_png(const Plot& plot) {
   };
   text(plot.title, kLeft + pw / 2, 22, 0.6, 1);
   const double xs = nice_step(x1 - x0, 8), ys = nice_step(y1 - y0, 8);
-  for (double x = std::ceil(x0 / xs) * xs; x <= x1 + 1e-9 * xs; x += xs) {
+  for (double x = std::ceil(x0 / xs) * xs; plot.x_ticks.empty() && x <= x1 + 1e-9 * xs; x += xs) {
     cv::line(img, P(X(x), kTop), P(X(x), kTop + ph), cv::Scalar(224, 224, 224));
     text(fmt::format("{:g}", std::abs(x) < 1e-12 * xs ? 0.0 : x), X(x), kTop + ph + 18, 0.4, 1);
   }
+  for (const auto& [x, label] : plot.x_ticks) text(label, X(x), kTop + ph + 18, 0.4, 1);
   for (double y = std::ceil(y0 / ys) * ys; y <= y1 + 1e-9 * ys; y += ys) {
     cv::line(img, P(kLeft, Y(y)), P(kLeft + pw, Y(y)), cv::Scalar(224, 224, 224));
     text(fmt::format("{:g}", std::abs(y) < 1e-12 * ys ? 0.0 : y), kLeft - 6, Y(y) + 4, 0.4, 2);
@@ -308,6 +362,27 @@ std::string render_png(const Plot& plot) {
   };
   for (size_t k = 0; k < plot.series.size(); ++k) {
     const PlotSeries& s = plot.series[k];
+    const double w = s.width * sx;
+    auto box = [&](double xc, double ya, double yb, int thickness) {
+      cv::rectangle(area, P(X(xc) - 0.5 * w - kLeft, Y(ya) - kTop),
+                    P(X(xc) + 0.5 * w - kLeft, Y(yb) - kTop), colour(k), thickness);
+    };
+    if (s.bars) {
+      for (size_t i = 0; i < s.x.size(); ++i) {
+        if (std::isfinite(s.x[i]) && std::isfinite(s.y[i])) box(s.x[i], 0.0, s.y[i], 1);
+      }
+      continue;
+    }
+    for (size_t i = 0; i < s.boxes.size() && i < s.x.size(); ++i) {
+      const auto& b = s.boxes[i];
+      const double cx = X(s.x[i]) - kLeft;
+      cv::line(area, P(cx, Y(b[0]) - kTop), P(cx, Y(b[1]) - kTop), colour(k));
+      cv::line(area, P(cx, Y(b[3]) - kTop), P(cx, Y(b[4]) - kTop), colour(k));
+      box(s.x[i], b[1], b[3], 1);
+      cv::line(area, P(cx - 0.5 * w, Y(b[2]) - kTop), P(cx + 0.5 * w, Y(b[2]) - kTop), colour(k),
+               2);
+    }
+    if (!s.boxes.empty()) continue;
     std::vector<cv::Point> pts;
     for (size_t i = 0; i < s.x.size(); ++i) {
       if (std::isfinite(s.x[i]) && std::isfinite(s.y[i]))

@@ -42,6 +42,31 @@ TEST(BenchStats, MatchHandComputedValues) {
   EXPECT_DOUBLE_EQ(statistics({1.0, 2.0, 10.0, 4.0}).median, 3.0);
 }
 
+// Box plot and histogram figures as numpy and matplotlib compute them (numpy 1.24:
+// np.percentile(v, [25, 50, 75]) = 3.5, 6, 8.5; whiskers at the furthest values within 1.5 IQR
+// of the box: 1 and 10, so 100 lies beyond; Freedman-Diaconis: ceil(99 / (2 * 5 / 11^(1/3))) =
+// 23 bins, np.histogram's counts 5, 4, 1, 0 ... 0, 1).
+TEST(BenchStats, DistributionAsNumpyAndMatplotlibDrawIt) {
+  const Distribution d = distribution({7, 100, 3, 9, 1, 10, 4, 6, 2, 8, 5});
+  EXPECT_EQ(d.n, 11u);
+  EXPECT_DOUBLE_EQ(d.q1, 3.5);
+  EXPECT_DOUBLE_EQ(d.median, 6.0);
+  EXPECT_DOUBLE_EQ(d.q3, 8.5);
+  EXPECT_DOUBLE_EQ(d.whisker_low, 1.0);
+  EXPECT_DOUBLE_EQ(d.whisker_high, 10.0);
+  EXPECT_DOUBLE_EQ(d.bin_low, 1.0);
+  ASSERT_EQ(d.counts.size(), 23u);
+  EXPECT_DOUBLE_EQ(d.bin_width, 99.0 / 23.0);
+  std::vector<size_t> want(23, 0);
+  want[0] = 5, want[1] = 4, want[2] = 1, want[22] = 1;
+  EXPECT_EQ(d.counts, want);
+  // The median between the two middle values of an even count, as statistics() gives it; all
+  // equal: one bin.
+  EXPECT_DOUBLE_EQ(distribution({4, 1, 3, 2}).median, statistics({4, 1, 3, 2}).median);
+  EXPECT_EQ(distribution({2, 2, 2}).counts, std::vector<size_t>{3});
+  EXPECT_EQ(distribution({}).n, 0u);
+}
+
 TEST(BenchAssociation, NearestMatchesBruteForce) {
   std::mt19937_64 rng(4);
   std::uniform_int_distribution<int64_t> step(1, 30'000'000);

@@ -83,6 +83,7 @@ struct Svg {
   std::string title;
   std::vector<size_t> polyline_points;
   size_t circles = 0;
+  size_t bars = 0;  // translucent rects (bars, histogram bins, boxes), each inside the frame
   std::vector<std::string> texts;
 };
 
@@ -116,6 +117,17 @@ Svg parse_svg(const fs::path& p) {
   for (auto it = std::sregex_iterator(s.begin(), s.end(), text); it != std::sregex_iterator(); ++it)
     svg.texts.push_back((*it)[1]);
   if (!svg.texts.empty()) svg.title = svg.texts.front();
+  const std::regex bar(
+      "<rect x=\"(-?[0-9.]+)\" y=\"(-?[0-9.]+)\" width=\"([0-9.]+)\" height=\"([0-9.]+)\" "
+      "fill=\"#[0-9a-f]+\" fill-opacity=");
+  for (auto it = std::sregex_iterator(s.begin(), s.end(), bar); it != std::sregex_iterator();
+       ++it) {
+    ++svg.bars;
+    const double x = std::stod((*it)[1]), y = std::stod((*it)[2]);
+    EXPECT_TRUE(x >= fx - 0.1 && x + std::stod((*it)[3]) <= fx + fw + 0.1 && y >= fy - 0.1 &&
+                y + std::stod((*it)[4]) <= fy + fh + 0.1)
+        << p << ": a bar outside the plot: " << (*it)[0];
+  }
   const std::regex polyline("<polyline [^>]*points=\"([^\"]*)\"/>");
   for (auto it = std::sregex_iterator(s.begin(), s.end(), polyline); it != std::sregex_iterator();
        ++it) {
@@ -498,7 +510,29 @@ TEST_F(Cli, BenchSeveralEstimatesAndTheirSavedResultsCompared) {
   EXPECT_EQ(slurp(dir_ / "cmp" / "compare.md"), table);
   const nlohmann::json cj = nlohmann::json::parse(slurp(dir_ / "cmp" / "compare.json"));
   EXPECT_EQ(cj["results"].size(), 2u);
-  EXPECT_TRUE(fs::exists(dir_ / "cmp" / "compare_ate.svg"));
+  // evo_res's plots: the statistics as bars (6 a result), and, from the distributions the
+  // reports saved, a box a result and the histograms.
+  EXPECT_NE(r.out.find("compare_ate_stats.svg, compare_ate_box.svg, compare_ate_histogram.svg"),
+            std::string::npos)
+      << r.out;
+  const Svg bars = parse_svg(dir_ / "cmp" / "compare_ate_stats.svg");
+  EXPECT_EQ(bars.bars, 12u);
+  for (const char* stat : {"rmse", "mean", "median", "std", "min", "max"})
+    EXPECT_TRUE(has_text(bars, stat)) << stat;
+  const nlohmann::json dg = jg["ate"]["trans"]["distribution"];
+  EXPECT_EQ(dg["n"], jg["n_pairs"]);
+  EXPECT_LE(dg["q1"].get<double>(), jg["ate"]["trans"]["median"].get<double>());
+  EXPECT_DOUBLE_EQ(dg["median"].get<double>(), jg["ate"]["trans"]["median"].get<double>());
+  size_t counted = 0;
+  for (const auto& c : dg["counts"]) counted += c.get<size_t>();
+  EXPECT_EQ(counted, jg["n_pairs"].get<size_t>());
+  const Svg box = parse_svg(dir_ / "cmp" / "compare_ate_box.svg");
+  EXPECT_EQ(box.bars, 2u);
+  EXPECT_TRUE(has_text(box, "good"));
+  EXPECT_TRUE(has_text(box, "poor"));
+  EXPECT_EQ(parse_svg(dir_ / "cmp" / "compare_ate_histogram.svg").bars,
+            dg["counts"].size() + jp["ate"]["trans"]["distribution"]["counts"].size());
+  EXPECT_TRUE(fs::exists(dir_ / "cmp" / "compare_rpe_box.svg"));
   // What is not a result is named.
   const fs::path other = write("other.json", "{\"a\": 1}");
   r = run("bench compare " + other.string());
