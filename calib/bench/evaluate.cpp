@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
@@ -100,33 +101,22 @@ std::vector<std::pair<size_t, size_t>> delta_pairs(const std::vector<SE3>& gt,
   return pairs;
 }
 
-// Like make_rpe for segments streamed from for_each_length_segment: keeps 16 bytes a segment
-// (for the medians) instead of the whole segment.
-RpeResult stream_rpe(std::string kind, std::string definition, const std::vector<SE3>& gt,
+// Like make_rpe for fixed-length segments, from their errors only (16 bytes a segment, not the
+// whole segment, for the medians).
+RpeResult length_rpe(std::string kind, std::string definition, const std::vector<SE3>& gt,
                      const std::vector<SE3>& est, const std::vector<double>& lengths, size_t step,
                      bool keep) {
   RpeResult r;
   r.kind = std::move(kind);
   r.definition = std::move(definition);
-  std::vector<double> t, a;
-  const size_t at_most = (gt.size() + step - 1) / step * lengths.size();
-  reserve_huge(t, at_most);  // no reallocation spikes on millions of segments
-  reserve_huge(a, at_most);
-  double t_rel = 0.0, r_rel = 0.0;
-  for_each_length_segment(gt, est, lengths, step, [&](const Segment& s) {
-    t.push_back(s.trans);
-    a.push_back(s.rot_deg);
-    t_rel += s.trans / s.length;
-    r_rel += s.rot_deg / s.length;
-    if (keep) r.segments.push_back(s);
-  });
-  r.drift.n_segments = t.size();
-  if (!t.empty()) {
-    r.drift.trans_pct = 100.0 * t_rel / static_cast<double>(t.size());
-    r.drift.rot_deg_per_m = r_rel / static_cast<double>(t.size());
+  SegmentErrors e = length_segment_errors(gt, est, lengths, step, keep ? &r.segments : nullptr);
+  r.drift.n_segments = e.trans.size();
+  if (!e.trans.empty()) {
+    r.drift.trans_pct = 100.0 * e.trans_per_length / static_cast<double>(e.trans.size());
+    r.drift.rot_deg_per_m = e.rot_deg_per_length / static_cast<double>(e.trans.size());
   }
-  r.trans = statistics(std::move(t));
-  r.rot_deg = statistics(std::move(a));
+  tbb::parallel_invoke([&] { r.trans = statistics_in_place(e.trans); },
+                       [&] { r.rot_deg = statistics_in_place(e.rot_deg); });
   return r;
 }
 
@@ -485,14 +475,16 @@ EvalResult evaluate(Trajectory gt, Trajectory est, const EvalOptions& opt) {
       tbb::parallel_for(tbb::blocked_range<size_t>(0, poses->size(), 4096), [&](const auto& r) {
         for (size_t i = r.begin(); i < r.end(); ++i) {
           Eigen::Matrix3d& R = (*poses)[i].R;
-          if (orthonormality_error(R) > 1e-13) R = nearest_rotation(R);
+          if (orthonormality_error(R) > 1e-13) R = nearest_rotation_near(R);
         }
       });
     }
   }
 
   res.alignment = align(m_gt, m_est, alignment, opt.align_first_n);
-  for (SE3& T : m_est) T = apply(res.alignment, T);  // aligned in place from here on
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, m_est.size(), 4096), [&](const auto& r) {
+    for (size_t i = r.begin(); i < r.end(); ++i) m_est[i] = apply(res.alignment, m_est[i]);
+  });  // aligned in place from here on
 
   PoseErrors ate = absolute_errors(m_gt, m_est);
   res.ate_trans = statistics(ate.trans);
@@ -517,9 +509,9 @@ EvalResult evaluate(Trajectory gt, Trajectory est, const EvalOptions& opt) {
       std::vector<double> lengths;
       for (double f : kVbrFractions) lengths.push_back(f * res.gt_length);
       res.rpe.push_back(
-          stream_rpe("kitti", "KITTI: segments of 100..800 m of GT path, a start every 10 frames",
+          length_rpe("kitti", "KITTI: segments of 100..800 m of GT path, a start every 10 frames",
                      m_gt, m_est, kitti_lengths, 10, keep));
-      res.rpe.push_back(stream_rpe(
+      res.rpe.push_back(length_rpe(
           "vbr",
           "VBR: segments of 1, 2, 3, 5, 8, 13, 21, 34, 55 % of the GT length, every frame a start",
           m_gt, m_est, lengths, 1, keep));

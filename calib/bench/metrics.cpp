@@ -16,7 +16,9 @@
 
 namespace rigcal::bench {
 
-Stats statistics(std::vector<double> values) {
+Stats statistics(std::vector<double> values) { return statistics_in_place(values); }
+
+Stats statistics_in_place(std::span<double> values) {
   Stats s;
   s.n = values.size();
   if (values.empty()) return s;
@@ -35,7 +37,7 @@ Stats statistics(std::vector<double> values) {
   double var = 0.0;
   for (double v : values) var += (v - s.mean) * (v - s.mean);
   s.std = std::sqrt(var / n);
-  s.median = median_midpoint(std::move(values));
+  s.median = median_midpoint_in_place(values);
   return s;
 }
 
@@ -217,27 +219,51 @@ Matches associate_by_index(const Trajectory& gt, const Trajectory& est) {
 }
 
 Interpolated interpolate_gt(const Trajectory& gt, const Trajectory& est, Time max_gap) {
-  Interpolated out;
-  reserve_huge(out.est, est.size());
-  reserve_huge(out.T_world_gt, est.size());
-  size_t j = 0;  // first GT stamp >= the estimate stamp
-  for (size_t i = 0; i < est.size(); ++i) {
-    const Time t = est.stamps[i];
-    while (j < gt.size() && gt.stamps[j] < t) ++j;
-    if (j == gt.size()) break;
-    if (gt.stamps[j] == t) {
-      out.est.push_back(i);
-      out.T_world_gt.push_back(gt.T_world_body[j]);
-      continue;
+  // In chunks of estimate stamps, in parallel: first counted, then written at their offsets.
+  constexpr size_t kChunk = size_t{1} << 14;
+  const size_t n = est.size(), n_chunks = (n + kChunk - 1) / kChunk;
+  // Calls take(i, j, fraction) for each estimate stamp of the chunk inside a GT interval no
+  // longer than max_gap (j: the first GT stamp at or after it; fraction < 0: at GT stamp j).
+  auto visit = [&](size_t chunk, auto&& take) {
+    const size_t i0 = chunk * kChunk, i1 = std::min(n, i0 + kChunk);
+    size_t j = static_cast<size_t>(
+        std::lower_bound(gt.stamps.begin(), gt.stamps.end(), est.stamps[i0]) - gt.stamps.begin());
+    for (size_t i = i0; i < i1; ++i) {
+      const Time t = est.stamps[i];
+      while (j < gt.size() && gt.stamps[j] < t) ++j;
+      if (j == gt.size()) return;
+      if (gt.stamps[j] == t) {
+        take(i, j, -1.0);
+        continue;
+      }
+      if (j == 0) continue;
+      const Time gap = gt.stamps[j] - gt.stamps[j - 1];
+      if (gap > max_gap) continue;
+      take(i, j, static_cast<double>((t - gt.stamps[j - 1]).ns) / static_cast<double>(gap.ns));
     }
-    if (j == 0) continue;
-    const Time gap = gt.stamps[j] - gt.stamps[j - 1];
-    if (gap > max_gap) continue;
-    const double fraction =
-        static_cast<double>((t - gt.stamps[j - 1]).ns) / static_cast<double>(gap.ns);
-    out.est.push_back(i);
-    out.T_world_gt.push_back(interpolate(gt.T_world_body[j - 1], gt.T_world_body[j], fraction));
-  }
+  };
+  std::vector<size_t> offset(n_chunks + 1, 0);
+  tbb::parallel_for(size_t{0}, n_chunks, [&](size_t c) {
+    size_t count = 0;
+    visit(c, [&](size_t, size_t, double) { ++count; });
+    offset[c + 1] = count;
+  });
+  for (size_t c = 0; c < n_chunks; ++c) offset[c + 1] += offset[c];
+  Interpolated out;
+  reserve_huge_touched(out.est, offset.back());
+  reserve_huge_touched(out.T_world_gt, offset.back());
+  out.est.resize(offset.back());
+  out.T_world_gt.resize(offset.back());
+  tbb::parallel_for(size_t{0}, n_chunks, [&](size_t c) {
+    size_t at = offset[c];
+    visit(c, [&](size_t i, size_t j, double fraction) {
+      out.est[at] = i;
+      out.T_world_gt[at] = fraction < 0
+                               ? gt.T_world_body[j]
+                               : interpolate(gt.T_world_body[j - 1], gt.T_world_body[j], fraction);
+      ++at;
+    });
+  });
   return out;
 }
 
@@ -329,20 +355,23 @@ SE3 apply(const AlignmentResult& alignment, const SE3& T_world_est) {
 PoseErrors absolute_errors(const std::vector<SE3>& T_world_gt,
                            const std::vector<SE3>& T_world_est) {
   PoseErrors e;
-  reserve_huge(e.trans, T_world_gt.size());
-  reserve_huge(e.rot_deg, T_world_gt.size());
+  reserve_huge_touched(e.trans, T_world_gt.size());
+  reserve_huge_touched(e.rot_deg, T_world_gt.size());
   e.trans.resize(T_world_gt.size());
   e.rot_deg.resize(T_world_gt.size());
-  for (size_t i = 0; i < T_world_gt.size(); ++i) {
-    e.trans[i] = (T_world_est[i].t - T_world_gt[i].t).norm();
-    e.rot_deg[i] = rotation_angle(T_world_gt[i].R.transpose() * T_world_est[i].R) * (180.0 / M_PI);
-  }
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, T_world_gt.size(), 4096), [&](const auto& r) {
+    for (size_t i = r.begin(); i < r.end(); ++i) {
+      e.trans[i] = (T_world_est[i].t - T_world_gt[i].t).norm();
+      e.rot_deg[i] =
+          rotation_angle(T_world_gt[i].R.transpose() * T_world_est[i].R) * (180.0 / M_PI);
+    }
+  });
   return e;
 }
 
 std::vector<double> cumulative_distances(const std::vector<SE3>& T_world_body) {
   std::vector<double> dist;
-  reserve_huge(dist, T_world_body.size());
+  reserve_huge_touched(dist, T_world_body.size());
   dist.resize(T_world_body.size(), 0.0);
   for (size_t i = 1; i < T_world_body.size(); ++i) {
     dist[i] = dist[i - 1] + (T_world_body[i].t - T_world_body[i - 1].t).norm();
@@ -361,57 +390,87 @@ double angle_of(const Eigen::Matrix3d& M) {
 }
 }  // namespace
 
-void for_each_length_segment(const std::vector<SE3>& T_world_gt,
-                             const std::vector<SE3>& T_world_est,
-                             const std::vector<double>& lengths, size_t step,
-                             const std::function<void(const Segment&)>& visit) {
+SegmentErrors length_segment_errors(const std::vector<SE3>& T_world_gt,
+                                    const std::vector<SE3>& T_world_est,
+                                    const std::vector<double>& lengths, size_t step,
+                                    std::vector<Segment>* segments) {
   const std::vector<double> dist = cumulative_distances(T_world_gt);
   const size_t n_starts = (dist.size() + step - 1) / step, n_len = lengths.size();
-  // Starts in blocks computed in parallel, then visited in order: the same sequence as one
-  // thread gives, in bounded memory (millions of segments for every-frame starts).
-  constexpr size_t kBlock = 8192;
-  std::vector<Segment> slots(std::min(n_starts, kBlock) * n_len);
-  std::vector<char> found(slots.size());
-  for (size_t b0 = 0; b0 < n_starts; b0 += kBlock) {
-    const size_t b1 = std::min(n_starts, b0 + kBlock);
-    tbb::parallel_for(tbb::blocked_range<size_t>(b0, b1, 256), [&](const auto& range) {
-      for (size_t s = range.begin(); s < range.end(); ++s) {
-        const size_t first = s * step;
-        const SE3& gi = T_world_gt[first];
-        const SE3& ei = T_world_est[first];
-        // E = inv(dP_est) dP_gt: |t(E)| = |t(dP_gt) - t(dP_est)| (a rotation keeps lengths), and
-        // R(E) = R_ej' A R_gj with A = R_ei R_gi', similar to A R_gj R_ej': the same angle.
-        const Eigen::Matrix3d A = ei.R * gi.R.transpose();
-        for (size_t k = 0; k < n_len; ++k) {
-          const size_t slot = (s - b0) * n_len + k;
-          // The first pose farther than the length along the GT path (the KITTI devkit's rule).
-          const auto it = std::upper_bound(dist.begin() + static_cast<std::ptrdiff_t>(first),
-                                           dist.end(), dist[first] + lengths[k]);
-          found[slot] = it != dist.end();
-          if (!found[slot]) continue;
-          const size_t last = static_cast<size_t>(it - dist.begin());
-          const SE3& gj = T_world_gt[last];
-          const SE3& ej = T_world_est[last];
-          const Eigen::Vector3d d_gt = gi.R.transpose() * (gj.t - gi.t);
-          const Eigen::Vector3d d_est = ei.R.transpose() * (ej.t - ei.t);
-          const Eigen::Matrix3d M = A * gj.R * ej.R.transpose();
-          slots[slot] = {first, last, lengths[k], (d_gt - d_est).norm(),
-                         angle_of(M) * (180.0 / M_PI)};
-        }
+  // A start has a segment of length k when the path after it is longer (the end is then the
+  // first pose farther than the length): the path left shrinks as the start advances, so the
+  // starts with one are the first with[k]. Start s's segments go from Σ_k min(s, with[k]) on.
+  std::vector<size_t> with(n_len);
+  size_t total = 0;
+  for (size_t k = 0; k < n_len; ++k) {
+    size_t lo = 0, hi = n_starts;
+    while (lo < hi) {
+      const size_t mid = lo + (hi - lo) / 2;
+      if (dist[mid * step] + lengths[k] < dist.back())
+        lo = mid + 1;
+      else
+        hi = mid;
+    }
+    with[k] = lo;
+    total += lo;
+  }
+  SegmentErrors out;
+  reserve_huge(out.trans, total);
+  reserve_huge(out.rot_deg, total);
+  out.trans.resize(total);
+  out.rot_deg.resize(total);
+  if (segments) {
+    reserve_huge_touched(*segments, total);
+    segments->resize(total);
+  }
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n_starts, 1024), [&](const auto& range) {
+    // Each length's end, carried from start to start: the ends only move forward.
+    std::vector<size_t> end(n_len, 0);
+    for (size_t s = range.begin(); s < range.end(); ++s) {
+      const size_t first = s * step;
+      size_t at = 0;
+      for (size_t k = 0; k < n_len; ++k) at += std::min(s, with[k]);
+      const SE3& gi = T_world_gt[first];
+      const SE3& ei = T_world_est[first];
+      // E = inv(dP_est) dP_gt: |t(E)| = |t(dP_gt) - t(dP_est)| (a rotation keeps lengths), and
+      // R(E) = R_ej' A R_gj with A = R_ei R_gi', similar to A R_gj R_ej': the same angle.
+      const Eigen::Matrix3d A = ei.R * gi.R.transpose();
+      for (size_t k = 0; k < n_len; ++k) {
+        if (s >= with[k]) continue;
+        // The first pose farther than the length along the GT path (the KITTI devkit's rule).
+        const double target = dist[first] + lengths[k];
+        size_t last = std::max(end[k], first);
+        while (dist[last] <= target) ++last;  // stops: the path after `first` is longer
+        end[k] = last;
+        const SE3& gj = T_world_gt[last];
+        const SE3& ej = T_world_est[last];
+        const Eigen::Vector3d d_gt = gi.R.transpose() * (gj.t - gi.t);
+        const Eigen::Vector3d d_est = ei.R.transpose() * (ej.t - ei.t);
+        const Eigen::Matrix3d M = A * gj.R * ej.R.transpose();
+        out.trans[at] = (d_gt - d_est).norm();
+        out.rot_deg[at] = angle_of(M) * (180.0 / M_PI);
+        if (segments) (*segments)[at] = {first, last, lengths[k], out.trans[at], out.rot_deg[at]};
+        ++at;
       }
-    });
-    for (size_t slot = 0; slot < (b1 - b0) * n_len; ++slot) {
-      if (found[slot]) visit(slots[slot]);
+    }
+  });
+  // The pooled sums in the segments' order, as one thread adds them.
+  size_t i = 0;
+  for (size_t s = 0; s < n_starts; ++s) {
+    for (size_t k = 0; k < n_len; ++k) {
+      if (s >= with[k]) continue;
+      out.trans_per_length += out.trans[i] / lengths[k];
+      out.rot_deg_per_length += out.rot_deg[i] / lengths[k];
+      ++i;
     }
   }
+  return out;
 }
 
 std::vector<Segment> length_segments(const std::vector<SE3>& T_world_gt,
                                      const std::vector<SE3>& T_world_est,
                                      const std::vector<double>& lengths, size_t step) {
   std::vector<Segment> segments;
-  for_each_length_segment(T_world_gt, T_world_est, lengths, step,
-                          [&](const Segment& s) { segments.push_back(s); });
+  length_segment_errors(T_world_gt, T_world_est, lengths, step, &segments);
   return segments;
 }
 
@@ -500,6 +559,7 @@ std::vector<std::pair<size_t, size_t>> evo_delta_pairs(const std::vector<SE3>& T
   if (unit == DeltaUnit::frames) {
     const size_t d = static_cast<size_t>(delta);
     if (static_cast<double>(d) != delta) throw Error("a delta in frames must be a whole number");
+    reserve_huge(pairs, all_pairs ? n : n / d + 1);
     for (size_t i = 0; i + d < n; i += all_pairs ? 1 : d) pairs.emplace_back(i, i + d);
     return pairs;
   }
@@ -540,14 +600,18 @@ std::vector<Segment> delta_errors(const std::vector<SE3>& T_world_gt,
                                   const std::vector<SE3>& T_world_est,
                                   const std::vector<std::pair<size_t, size_t>>& pairs) {
   std::vector<Segment> segments;
-  reserve_huge(segments, pairs.size());
+  reserve_huge_touched(segments, pairs.size());
+  segments.resize(pairs.size());
   const std::vector<double> dist = cumulative_distances(T_world_gt);
-  for (const auto& [i, j] : pairs) {
-    const SE3 dQ = T_world_gt[i].inverse() * T_world_gt[j];
-    const SE3 dP = T_world_est[i].inverse() * T_world_est[j];
-    const SE3 E = dQ.inverse() * dP;
-    segments.push_back({i, j, dist[j] - dist[i], E.t.norm(), rotation_angle(E.R) * (180.0 / M_PI)});
-  }
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, pairs.size(), 4096), [&](const auto& r) {
+    for (size_t k = r.begin(); k < r.end(); ++k) {
+      const auto [i, j] = pairs[k];
+      const SE3 dQ = T_world_gt[i].inverse() * T_world_gt[j];
+      const SE3 dP = T_world_est[i].inverse() * T_world_est[j];
+      const SE3 E = dQ.inverse() * dP;
+      segments[k] = {i, j, dist[j] - dist[i], E.t.norm(), rotation_angle(E.R) * (180.0 / M_PI)};
+    }
+  });
   return segments;
 }
 

@@ -3,8 +3,10 @@
 // rigcal::Trajectory; conventions of other tools (evo, KITTI devkit, VBR evaluator) are selected
 // in calib/bench/evaluate.h.
 #include <functional>
+#include <span>
 #include <vector>
 
+#include "rigcal/core/memory.h"
 #include "rigcal/core/trajectory.h"
 
 namespace rigcal::bench {
@@ -17,6 +19,7 @@ struct Stats {
 // By value: give it an rvalue to let the median reorder the values in place (millions of
 // segment errors are not copied).
 Stats statistics(std::vector<double> values);
+Stats statistics_in_place(std::span<double> values);  // reorders them (the median)
 
 // The shape of a set of errors, for box plots and histograms (evo_res's): quartiles by linear
 // interpolation between order statistics (numpy's percentile), whiskers at the furthest values
@@ -104,11 +107,18 @@ struct Segment {
 };
 // Segments of fixed lengths, KITTI-style: starts every `step` frames; a segment ends at the first
 // pose whose GT distance from the start exceeds the length. E = inv(dP_est) * dP_gt.
-// The visitor form streams them (millions for every-frame starts) without storing them.
-void for_each_length_segment(const std::vector<SE3>& T_world_gt,
-                             const std::vector<SE3>& T_world_est,
-                             const std::vector<double>& lengths, size_t step,
-                             const std::function<void(const Segment&)>& visit);
+// length_segment_errors keeps their errors only (16 bytes a segment: millions for every-frame
+// starts), start by start and each start's lengths in order, computed in parallel; with
+// `segments`, every segment too. The sums of trans / length and rot_deg / length are added in
+// that order.
+struct SegmentErrors {
+  UninitialisedVector<double> trans, rot_deg;  // m, deg
+  double trans_per_length = 0, rot_deg_per_length = 0;
+};
+SegmentErrors length_segment_errors(const std::vector<SE3>& T_world_gt,
+                                    const std::vector<SE3>& T_world_est,
+                                    const std::vector<double>& lengths, size_t step,
+                                    std::vector<Segment>* segments = nullptr);
 std::vector<Segment> length_segments(const std::vector<SE3>& T_world_gt,
                                      const std::vector<SE3>& T_world_est,
                                      const std::vector<double>& lengths, size_t step);

@@ -115,6 +115,19 @@ Eigen::Matrix3d nearest_rotation(const Eigen::Matrix3d& M) {
   return svd.matrixU() * D * svd.matrixV().transpose();
 }
 
+Eigen::Matrix3d nearest_rotation_near(const Eigen::Matrix3d& M) {
+  if (!(orthonormality_error(M) <= 1e-3) || !(M.determinant() > 0)) return nearest_rotation(M);
+  Eigen::Matrix3d R = M;
+  // Until orthonormal to rounding, or no better (rounding's floor can lie above 1e-15).
+  for (double error = orthonormality_error(R); error > 1e-15;) {
+    const Eigen::Matrix3d next = 0.5 * R * (3.0 * Eigen::Matrix3d::Identity() - R.transpose() * R);
+    const double next_error = orthonormality_error(next);
+    if (!(next_error < error)) break;
+    R = next, error = next_error;
+  }
+  return R;
+}
+
 std::string to_text(const SE3& T_a_b) {
   const Eigen::Quaterniond q = T_a_b.quaternion();
   return fmt::format("{} {} {} {} {} {} {}", T_a_b.t.x(), T_a_b.t.y(), T_a_b.t.z(), q.x(), q.y(),

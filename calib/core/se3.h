@@ -46,6 +46,11 @@ Eigen::Matrix3d from_roll_pitch_yaw(double roll, double pitch, double yaw);
 double orthonormality_error(const Eigen::Matrix3d& R);
 // The rotation closest to M in the Frobenius norm (SVD projection).
 Eigen::Matrix3d nearest_rotation(const Eigen::Matrix3d& M);
+// The same for a matrix already near a rotation (a rotation written with few digits): Newton-
+// Schulz steps R <- R (3 I - R'R) / 2 to orthonormality at rounding, which converge to the SVD's
+// answer (the polar factor) quadratically, six times faster; the SVD itself when M is far
+// (max |M'M - I| > 1e-3) or its determinant is not positive.
+Eigen::Matrix3d nearest_rotation_near(const Eigen::Matrix3d& M);
 Eigen::Matrix3d skew(const Eigen::Vector3d& v);
 // SO(3)'s right Jacobian J_r(phi): Exp(phi + d) = Exp(phi) Exp(J_r(phi) d) to first order; and
 // its inverse: Log(Exp(phi) Exp(d)) = phi + J_r(phi)^-1 d.

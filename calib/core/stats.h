@@ -2,6 +2,7 @@
 // Small robust statistics shared by the modules.
 #include <algorithm>
 #include <cmath>
+#include <span>
 #include <vector>
 
 namespace rigcal {
@@ -16,7 +17,8 @@ inline double median(std::vector<double> v) {
 
 // The median with the two middle values of an even count averaged (the textbook's, numpy's);
 // NaN when empty.
-inline double median_midpoint(std::vector<double> v) {
+// In place: reorders v.
+inline double median_midpoint_in_place(std::span<double> v) {
   if (v.empty()) return NAN;
   const size_t mid = v.size() / 2;
   std::nth_element(v.begin(), v.begin() + mid, v.end());
@@ -25,6 +27,7 @@ inline double median_midpoint(std::vector<double> v) {
   const double lower = *std::max_element(v.begin(), v.begin() + mid);
   return 0.5 * (lower + upper);
 }
+inline double median_midpoint(std::vector<double> v) { return median_midpoint_in_place(v); }
 
 // The root mean square; 0 when empty.
 inline double rms(const std::vector<double>& v) {

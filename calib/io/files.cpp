@@ -12,6 +12,7 @@
 #include <fstream>
 
 #include "rigcal/core/error.h"
+#include "rigcal/core/memory.h"
 
 namespace rigcal::io {
 
@@ -42,7 +43,7 @@ void read_text_blocks(const fs::path& path,
     throw Error(fmt::format("{}: cannot open: {}", path.string(), std::strerror(errno)));
   }
   // One buffer reused: the lines cut at a block's end move to its front before the next read.
-  std::string buffer(block_bytes + 1, '\0');
+  UninitialisedVector<char> buffer(block_bytes + 1);  // read into, not zeroed first
   size_t kept = 0;
   while (true) {
     in.read(buffer.data() + kept, static_cast<std::streamsize>(buffer.size() - kept));

@@ -1,6 +1,9 @@
 // Core types: SE3 algebra and conversions, exact time parsing, strict number parsing.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <bit>
+#include <charconv>
 #include <cmath>
 #include <random>
 
@@ -71,6 +74,64 @@ TEST(SE3, NearestRotationAndOrthonormalityError) {
   const Eigen::Matrix3d R = nearest_rotation(M);
   EXPECT_LT(orthonormality_error(R), 1e-15);
   EXPECT_NEAR(R.determinant(), 1.0, 1e-15);
+}
+
+// Newton-Schulz steps give the SVD's nearest rotation for rotations written with 7 to 10 digits
+// (KITTI rows) and with errors up to 1e-3; farther, or reflected, the SVD itself.
+TEST(SE3, NearestRotationOfANearMatrixIsTheSvds) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  for (double size : {1e-10, 1e-7, 1e-4, 3e-4}) {
+    for (int trial = 0; trial < 50; ++trial) {
+      Eigen::Matrix3d M = from_roll_pitch_yaw(3 * noise(rng), noise(rng), 3 * noise(rng));
+      for (int i = 0; i < 9; ++i) M(i / 3, i % 3) += size * noise(rng);
+      const Eigen::Matrix3d R = nearest_rotation_near(M);
+      EXPECT_LT((R - nearest_rotation(M)).cwiseAbs().maxCoeff(), 2e-15) << size;
+      EXPECT_LE(orthonormality_error(R), 4e-15) << size;  // the rounding floor of R'R
+    }
+  }
+  Eigen::Matrix3d far = from_roll_pitch_yaw(0.3, 0.2, 0.1);
+  far(0, 1) += 0.1;
+  EXPECT_EQ(nearest_rotation_near(far), nearest_rotation(far));
+  const Eigen::Matrix3d reflection = Eigen::Vector3d(1, 1, -1).asDiagonal();
+  EXPECT_EQ(nearest_rotation_near(reflection), nearest_rotation(reflection));
+}
+
+// parse_double's fast path for short decimals gives from_chars' double to the bit, on numbers
+// printed as trajectory files print them (KITTI's %.9e, %.6f, shortest round trip, integers,
+// leading and trailing zeros, signs, exponents near the path's limits).
+TEST(Text, ParseDoubleEqualsFromCharsToTheBit) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_int_distribution<int> power(-30, 30);
+  std::vector<std::string> texts = {"0",
+                                    "-0",
+                                    "0.0",
+                                    "1.",
+                                    ".5",
+                                    "-.25",
+                                    "1e22",
+                                    "1e23",
+                                    "9e-22",
+                                    "1.000000000e+00",
+                                    "-0.000000000e+00",
+                                    "007.50",
+                                    "1E5",
+                                    "9007199254740993",
+                                    "9007199254740992",
+                                    "123456789012345678",
+                                    "0.1000000000000000055511151231257827"};
+  for (int k = 0; k < 20000; ++k) {
+    const double v = unit(rng) * std::pow(10.0, power(rng));
+    for (const char* format : {"{:.9e}", "{:.6f}", "{}", "{:.3f}", "{:.15g}", "{:.0f}"})
+      texts.push_back(fmt::format(fmt::runtime(format), v));
+  }
+  for (const std::string& text : texts) {
+    double want = 0;
+    std::from_chars(text.data(), text.data() + text.size(), want);
+    const double got = parse_double(text, "x");
+    EXPECT_EQ(std::bit_cast<uint64_t>(got), std::bit_cast<uint64_t>(want)) << text;
+  }
 }
 
 TEST(Time, ParsesDecimalSecondsExactly) {
