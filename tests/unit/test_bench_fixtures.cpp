@@ -77,6 +77,24 @@ TEST(BenchPeers, EvoOnKitti00MatchesToOneBillionth) {
   EXPECT_REL(evaluate(gt, est, o).ate_trans.rmse, 7.7902889, 1e-7);
 }
 
+// One of evo's stats.json figures against rigcal's: APE or RPE (the delta pairs), translation
+// or angle; n exactly, rmse, mean, median, std and max to 1e-9 relative, and the minimum to 1e-12
+// absolute (evo's smallest errors are differences of nearly equal numbers).
+template <class Row>
+void expect_evo_figures(const EvalResult& r, bool rpe, bool angle, const Row& evo) {
+  const Stats& s = rpe ? (angle ? find_rpe(r, "delta")->rot_deg : find_rpe(r, "delta")->trans)
+                       : (angle ? r.ate_rot_deg : r.ate_trans);
+  EXPECT_EQ(s.n, evo.n);
+  for (auto [got, want] : {std::pair{s.rmse, evo.rmse},
+                           {s.mean, evo.mean},
+                           {s.median, evo.median},
+                           {s.std, evo.std},
+                           {s.max, evo.max}}) {
+    EXPECT_LE(std::abs(got - want), 1e-9 * std::abs(want)) << got << " vs evo's " << want;
+  }
+  EXPECT_NEAR(s.min, evo.min, 1e-12);
+}
+
 // evo 1.36.5 (the fixtures' commit, run from its source with Debian's numpy) on every TUM and
 // EuRoC pair of its test data, figures from the zip's stats.json (full float64 digits): APE with
 // and without -a and -s, RPE -d 1 -u f, translation and angle_deg. The files are given as a user
@@ -137,19 +155,7 @@ TEST(BenchPeers, EvoOnEveryTumAndEurocFixtureToOneBillionth) {
     o.convention = "evo";
     o.align = row.align;
     const PairRun run = score_pair(o);
-    const Stats& s = row.rpe ? (row.angle ? find_rpe(run.result, "delta")->rot_deg
-                                          : find_rpe(run.result, "delta")->trans)
-                             : (row.angle ? run.result.ate_rot_deg : run.result.ate_trans);
-    EXPECT_EQ(s.n, row.n);
-    for (auto [got, want] : {std::pair{s.rmse, row.rmse},
-                             {s.mean, row.mean},
-                             {s.median, row.median},
-                             {s.std, row.std},
-                             {s.max, row.max}}) {
-      EXPECT_LE(std::abs(got - want), 1e-9 * std::abs(want)) << got << " vs evo's " << want;
-    }
-    // evo's smallest errors are differences of nearly equal numbers: absolute agreement.
-    EXPECT_NEAR(s.min, row.min, 1e-12);
+    expect_evo_figures(run.result, row.rpe, row.angle, row);
   }
 }
 
@@ -716,18 +722,7 @@ TEST(BenchPeers, EvoTimeWindowsOffsetsAndDeltaUnitsToOneBillionth) {
     o.t_start = row.t_start;
     o.t_end = row.t_end;
     const PairRun run = score_pair(o);
-    const Stats& s = row.rpe ? (row.angle ? find_rpe(run.result, "delta")->rot_deg
-                                          : find_rpe(run.result, "delta")->trans)
-                             : (row.angle ? run.result.ate_rot_deg : run.result.ate_trans);
-    EXPECT_EQ(s.n, row.n);
-    for (auto [got, want] : {std::pair{s.rmse, row.rmse},
-                             {s.mean, row.mean},
-                             {s.median, row.median},
-                             {s.std, row.std},
-                             {s.max, row.max}}) {
-      EXPECT_LE(std::abs(got - want), 1e-9 * std::abs(want)) << got << " vs evo's " << want;
-    }
-    EXPECT_NEAR(s.min, row.min, 1e-12);
+    expect_evo_figures(run.result, row.rpe, row.angle, row);
   }
 }
 
