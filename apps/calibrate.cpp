@@ -81,7 +81,8 @@ void add_calibrate(CLI::App& app) {
   cmd->add_option("--only", o->run.only,
                   "rerun only this step; the others from the cache where it holds them");
   cmd->add_option("--model", o->run.cameras.model,
-                  "camera model: pinhole-radtan | pinhole-radtan5 | pinhole-equidistant")
+                  "camera model: pinhole-radtan | pinhole-radtan5 | pinhole-equidistant (Kalibr's\n"
+                  "pinhole-equi), or NAME=MODEL,NAME=MODEL (one model for all cameras today)")
       ->capture_default_str();
   cmd->add_option("--bayer", o->bayer, "raw Bayer images: rggb | bggr | grbg | gbrg");
   cmd->add_option("--lidar-camera", o->run.lidar_camera.camera,

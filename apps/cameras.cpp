@@ -79,7 +79,10 @@ void add_cameras(CLI::App& app) {
   cmd->add_option("--session", o->session,
                   "a session (its stereo/ recording) or a recording with camera_left/ and "
                   "camera_right/, or a bag, folder of bags or capture (doc/session.md)");
-  cmd->add_option("--model", o->model, "pinhole-radtan | pinhole-radtan5 | pinhole-equidistant")
+  cmd->add_option(
+         "--model", o->model,
+         "pinhole-radtan | pinhole-radtan5 | pinhole-equidistant (Kalibr's pinhole-equi);\n"
+         "or per camera: cam_l=pinhole-radtan,cam_r=pinhole-radtan (one model for all today)")
       ->capture_default_str();
   cmd->add_option("--rig", o->rig, "rig to update (default: a new rig of these cameras)");
   cmd->add_option("--out", o->out, "output calibration YAML")->required();

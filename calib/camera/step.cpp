@@ -16,6 +16,7 @@
 #include "rigcal/camera/uncertainty.h"
 #include "rigcal/core/error.h"
 #include "rigcal/core/stats.h"
+#include "rigcal/core/text.h"
 #include "rigcal/io/files.h"
 #include "rigcal/io/target_yaml.h"
 #include "rigcal/report/json.h"
@@ -25,20 +26,64 @@
 namespace rigcal::camera {
 namespace {
 
-CalibrationOptions calibration_options(const StepOptions& o) {
-  CalibrationOptions c;
-  if (o.model == "pinhole-radtan")
+// A lens model by rigcal's name or Kalibr's (Kalibr's pinhole-equi is pinhole-equidistant).
+void set_model(std::string_view name, CalibrationOptions& c) {
+  if (name == "pinhole-radtan")
     c.model = rig::DistortionModel::radtan, c.radtan_coefficients = 4;
-  else if (o.model == "pinhole-radtan5")
+  else if (name == "pinhole-radtan5")
     c.model = rig::DistortionModel::radtan, c.radtan_coefficients = 5;
-  else if (o.model == "pinhole-equidistant")
+  else if (name == "pinhole-equidistant" || name == "pinhole-equi")
     c.model = rig::DistortionModel::equidistant;
+  else if (name == "pinhole-fov" || name == "omni-none" || name == "omni-radtan" ||
+           name == "eucm-none" || name == "ds-none")
+    throw Error(fmt::format(
+        "--model: Kalibr's {} has no counterpart in rigcal; its models are pinhole-radtan (also "
+        "pinhole-radtan5, with k3) and pinhole-equidistant (Kalibr's pinhole-equi)",
+        name));
   else
     throw Error(fmt::format(
-        "--model: expected pinhole-radtan, pinhole-radtan5 or pinhole-equidistant, got '{}'",
-        o.model));
+        "--model: expected pinhole-radtan, pinhole-radtan5 or pinhole-equidistant (or Kalibr's "
+        "pinhole-equi), got '{}'",
+        name));
+}
+
+// --model MODEL for every camera, or NAME=MODEL,NAME=MODEL per camera (every camera named).
+CalibrationOptions calibration_options(const StepOptions& o,
+                                       const std::vector<std::string>& names) {
+  CalibrationOptions c;
   c.outlier_k_sigma = o.outlier_sigma;
-  return c;
+  if (o.model.find('=') == std::string::npos) {
+    set_model(o.model, c);
+    return c;
+  }
+  std::map<std::string, std::string> per_camera;
+  for (std::string_view item : split_fields(o.model)) {
+    const size_t eq = item.find('=');
+    if (eq == std::string_view::npos)
+      throw Error(fmt::format("--model: expected NAME=MODEL in a list, got '{}'", item));
+    const std::string name(item.substr(0, eq));
+    if (std::find(names.begin(), names.end(), name) == names.end())
+      throw Error(
+          fmt::format("--model: no camera '{}' (the cameras: {})", name, fmt::join(names, ", ")));
+    per_camera[name] = std::string(item.substr(eq + 1));
+  }
+  std::optional<CalibrationOptions> first;
+  for (const std::string& name : names) {
+    const auto it = per_camera.find(name);
+    if (it == per_camera.end()) throw Error(fmt::format("--model: no model for camera '{}'", name));
+    CalibrationOptions one = c;
+    set_model(it->second, one);
+    if (first &&
+        (one.model != first->model || one.radtan_coefficients != first->radtan_coefficients)) {
+      throw Error(fmt::format(
+          "--model {}: the cameras are fitted together with one lens model today; different "
+          "models per camera are not supported yet (calibrate each camera on its own with its "
+          "model, then the pair with one model)",
+          o.model));
+    }
+    if (!first) first = one;
+  }
+  return *first;
 }
 
 struct Detections {
@@ -222,8 +267,8 @@ nlohmann::json stereo_rectification(const CalibrationResult& r, const Detections
 report::StepResult calibrate_cameras(const StepInputs& in, const StepOptions& o,
                                      const report::Progress& progress) {
   const Target target = io::read_target_file(in.target);
-  const CalibrationOptions copt = calibration_options(o);
   const std::vector<std::string>& names = in.images.names;
+  const CalibrationOptions copt = calibration_options(o, names);
   if (names.empty() || in.images.files.empty() || in.images.files[0].empty())
     throw Error("the camera step was given no images");
   const size_t n_cams = names.size(), n_frames = in.images.files[0].size();

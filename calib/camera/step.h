@@ -13,9 +13,11 @@
 namespace rigcal::camera {
 
 struct StepOptions {
-  std::string model = "pinhole-radtan";  // pinhole-radtan | pinhole-radtan5 | pinhole-equidistant
-  double outlier_sigma = 4.0;            // corners beyond this many sigma are dropped
-  io::Bayer bayer = io::Bayer::none;     // raw mosaics: demosaiced to gray
+  // pinhole-radtan | pinhole-radtan5 | pinhole-equidistant (Kalibr's pinhole-equi), or
+  // NAME=MODEL,NAME=MODEL naming every camera (the same model for all: one lens model is fitted).
+  std::string model = "pinhole-radtan";
+  double outlier_sigma = 4.0;         // corners beyond this many sigma are dropped
+  io::Bayer bayer = io::Bayer::none;  // raw mosaics: demosaiced to gray
   // Also the detections fitted to the given rig's lenses and stereo poses, only the boards free
   // (rigcal check: the new data at the stored calibration): the report's `at_rig` and the
   // residual figures named `..._at_rig_<unit>`; a note when the rig's cameras cannot be fitted.

@@ -29,10 +29,11 @@ struct ExportOptions {
 // (t_imu = t_cam + shift). Throws for radtan with k3 != 0 (Kalibr's radtan has four coefficients).
 std::string kalibr_camchain_yaml(const Rig& rig, const ExportOptions& options = {});
 
-// OpenCV FileStorage YAML for the first one or two cameras, named as cv::stereoCalibrate and the
-// stereo_calib sample name them: K1 D1 (K2 D2), image_size1 (image_size2), R T E F (p2 = R p1 + T,
-// metres) and the rectification R1 R2 P1 P2 Q of cv::stereoRectify (cv::fisheye for equidistant),
-// zero disparity, alpha (balance) 0.
+// OpenCV FileStorage YAML for the first one or two cameras, one file: K1 D1 (K2 D2), image_size1
+// (image_size2), R T E F as cv::stereoCalibrate names them (p2 = R p1 + T, metres) and the
+// rectification R1 R2 P1 P2 Q of cv::stereoRectify (cv::fisheye for equidistant), zero disparity,
+// alpha (balance) 0. Not the stereo_calib sample's two files (intrinsics.yml M1 D1 M2 D2,
+// extrinsics.yml), doc/exports.md.
 std::string opencv_yaml(const Rig& rig);
 
 // ROS camera_info YAML (camera_calibration_parsers) of one camera. With a stereo pair of equal

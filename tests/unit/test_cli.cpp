@@ -675,6 +675,37 @@ TEST_F(Cli, CamerasErrorsAreOneLineAndWriteNothing) {
   EXPECT_FALSE(fs::exists(report));
 }
 
+// --model by rigcal's names or Kalibr's, for all cameras or each by name; what the solver cannot
+// fit (different models per camera, Kalibr's models without a counterpart) refused, named.
+TEST_F(Cli, CamerasModelNamesKalibrsAndPerCamera) {
+  RIGCAL_REQUIRE_FIXTURE(dir, "stereo/opencv_samples");
+  const std::string out = (dir_ / "calib.yaml").string(), report = (dir_ / "report").string();
+  const std::string args = "cameras --target " RIGCAL_SOURCE_DIR
+                           "/targets/checkerboard_9x6_25mm.yaml --camera 'left=" +
+                           dir + "/left*.jpg' --camera 'right=" + dir + "/right*.jpg' --out " +
+                           out + " --report " + report + " --model ";
+  CliRun r = run(args + "left=pinhole-equi,right=pinhole-equi");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const rigcal::rig::Rig calib = rigcal::rig::read_rig_file(out);
+  for (const char* cam : {"left", "right"}) {
+    EXPECT_EQ(rigcal::rig::sensor(calib, cam).camera.distortion_model,
+              rigcal::rig::DistortionModel::equidistant);
+  }
+  struct Refusal {
+    const char *model, *says;
+  };
+  for (const Refusal& bad :
+       {Refusal{"left=pinhole-radtan,right=pinhole-equi", "different models per camera"},
+        Refusal{"omni-radtan", "Kalibr's omni-radtan has no counterpart in rigcal"},
+        Refusal{"left=pinhole-radtan", "no model for camera 'right'"},
+        Refusal{"left=pinhole-radtan,middle=pinhole-radtan", "no camera 'middle'"},
+        Refusal{"pinhole-fisheye", "expected pinhole-radtan, pinhole-radtan5 or"}}) {
+    r = run(args + bad.model);
+    EXPECT_EQ(r.status, 2) << bad.model;
+    EXPECT_NE(r.err.find(bad.says), std::string::npos) << bad.model << ": " << r.err;
+  }
+}
+
 TEST_F(Cli, CamerasOnTheOpenCvSamplesWritesRigAndReport) {
   RIGCAL_REQUIRE_FIXTURE(dir, "stereo/opencv_samples");
   const std::string out = (dir_ / "calib.yaml").string(), report = (dir_ / "report").string();
