@@ -55,8 +55,9 @@ void add_publish(CLI::App& app) {
   cmd->add_option("calibration", o->calibration, "the calibration YAML (rigcal calibrate's)")
       ->required();
   cmd->add_option("sequences", o->sequences, "sequence folders")->required();
-  cmd->add_option("--formats", o->formats,
-                  "comma-separated: vbr (always), rigcal, kalibr, ros, opencv, mrcal")
+  cmd->add_option(
+         "--formats", o->formats,
+         "comma-separated: vbr (always), rigcal, kalibr, ros, opencv, opencv-sample, mrcal")
       ->capture_default_str();
   cmd->add_flag("--force", o->force, "replace a different calibration");
   cmd->callback([o] { run(*o); });

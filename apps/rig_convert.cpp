@@ -27,14 +27,18 @@ void add_rig_convert(CLI::App& parent) {
       "  vbr     only the keys of the published vbr_calib.yaml\n"
       "  kalibr  Kalibr camchain (T_cn_cnm1, T_cam_imu, timeshift_cam_imu)\n"
       "  opencv  cv::FileStorage YAML: K1 D1 K2 D2 R T E F + stereo rectification\n"
+      "  opencv-sample  OpenCV's stereo_calib sample's intrinsics.yml (M1 D1 M2 D2) and\n"
+      "          extrinsics.yml (R T R1 R2 P1 P2 Q, alpha 1) into the folder --out\n"
       "  ros     one camera_info YAML per camera into the folder --out\n"
       "  mrcal   one .cameramodel per camera into the folder --out\n"
       "Files are written to a temporary name and renamed: a failed run writes nothing.");
   cmd->add_option("file", o->file,
                   "calibration file (rigcal, VBR, Kalibr camchain, ROS camera_info, OpenCV, mrcal)")
       ->required();
-  cmd->add_option("--to", o->to, "rigcal | vbr | kalibr | opencv | ros | mrcal")->required();
-  cmd->add_option("--out", o->out, "output file (a folder for ros and mrcal)")->required();
+  cmd->add_option("--to", o->to, "rigcal | vbr | kalibr | opencv | opencv-sample | ros | mrcal")
+      ->required();
+  cmd->add_option("--out", o->out, "output file (a folder for opencv-sample, ros and mrcal)")
+      ->required();
   cmd->add_option("--imu", o->imu,
                   "kalibr: the IMU for T_cam_imu (default: the sensor 'imu', else the first IMU)");
   cmd->callback([o] {

@@ -62,7 +62,7 @@ struct Rectification {
 
 // Stereo rectification as OpenCV computes it; none when the pair cannot be rectified together
 // (different image sizes or different lens models).
-std::optional<Rectification> rectification(const StereoPair& pair) {
+std::optional<Rectification> rectification(const StereoPair& pair, double alpha = 0.0) {
   const CameraModel& c0 = pair.cam0->camera;
   const CameraModel& c1 = pair.cam1->camera;
   if (c0.width != c1.width || c0.height != c1.height ||
@@ -74,11 +74,11 @@ std::optional<Rectification> rectification(const StereoPair& pair) {
   Rectification r;
   if (c0.distortion_model == DistortionModel::radtan) {
     cv::stereoRectify(to_cv(c0.K()), distortion(c0), to_cv(c1.K()), distortion(c1), size, R, T,
-                      r.R1, r.R2, r.P1, r.P2, r.Q, cv::CALIB_ZERO_DISPARITY, 0.0, size);
+                      r.R1, r.R2, r.P1, r.P2, r.Q, cv::CALIB_ZERO_DISPARITY, alpha, size);
   } else {
     cv::fisheye::stereoRectify(to_cv(c0.K()), distortion(c0), to_cv(c1.K()), distortion(c1), size,
                                R, T, r.R1, r.R2, r.P1, r.P2, r.Q, cv::CALIB_ZERO_DISPARITY, size,
-                               0.0, 1.0);
+                               alpha, 1.0);
   }
   return r;
 }
@@ -94,12 +94,15 @@ std::string default_kalibr_imu(const Rig& rig) {
 }  // namespace
 
 ExportFormat export_format_from_string(std::string_view name) {
-  for (ExportFormat f : {ExportFormat::rigcal, ExportFormat::vbr, ExportFormat::kalibr,
-                         ExportFormat::opencv, ExportFormat::ros, ExportFormat::mrcal}) {
+  for (ExportFormat f :
+       {ExportFormat::rigcal, ExportFormat::vbr, ExportFormat::kalibr, ExportFormat::opencv,
+        ExportFormat::opencv_sample, ExportFormat::ros, ExportFormat::mrcal}) {
     if (name == to_string(f)) return f;
   }
   throw Error(fmt::format(
-      "unknown export format '{}'; expected one of rigcal, vbr, kalibr, opencv, ros, mrcal", name));
+      "unknown export format '{}'; expected one of rigcal, vbr, kalibr, opencv, opencv-sample, "
+      "ros, mrcal",
+      name));
 }
 
 std::string_view to_string(ExportFormat format) {
@@ -112,6 +115,8 @@ std::string_view to_string(ExportFormat format) {
       return "kalibr";
     case ExportFormat::opencv:
       return "opencv";
+    case ExportFormat::opencv_sample:
+      return "opencv-sample";
     case ExportFormat::ros:
       return "ros";
     case ExportFormat::mrcal:
@@ -121,7 +126,8 @@ std::string_view to_string(ExportFormat format) {
 }
 
 bool writes_folder(ExportFormat format) {
-  return format == ExportFormat::ros || format == ExportFormat::mrcal;
+  return format == ExportFormat::ros || format == ExportFormat::mrcal ||
+         format == ExportFormat::opencv_sample;
 }
 
 std::string kalibr_camchain_yaml(const Rig& rig, const ExportOptions& options) {
@@ -206,6 +212,40 @@ std::string opencv_yaml(const Rig& rig) {
     }
   }
   return fs.releaseAndGetString();
+}
+
+OpenCvSampleFiles opencv_sample_files(const Rig& rig) {
+  validate(rig);
+  const std::optional<StereoPair> pair = stereo_pair(rig);
+  if (!pair) {
+    throw Error(
+        "opencv-sample is the layout of OpenCV's stereo sample: it needs two cameras (one "
+        "camera: --to opencv or ros)");
+  }
+  const std::optional<Rectification> r = rectification(*pair, 1.0);
+  if (!r) {
+    throw Error(
+        fmt::format("opencv-sample: {} and {} differ in image size or lens model, and the sample's "
+                    "extrinsics.yml holds their common rectification",
+                    pair->cam0->name, pair->cam1->name));
+  }
+  auto storage = [] {
+    return cv::FileStorage(
+        ".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
+  };
+  cv::FileStorage in = storage(), ex = storage();
+  in.writeComment(fmt::format(" Written by {}. M1 D1: {}, M2 D2: {} ({}).", version_string(),
+                              pair->cam0->name, pair->cam1->name,
+                              pair->cam0->camera.distortion_model == DistortionModel::radtan
+                                  ? "cv::calibrateCamera's model"
+                                  : "cv::fisheye's model"));
+  in << "M1" << to_cv(pair->cam0->camera.K()) << "D1" << distortion(pair->cam0->camera);
+  in << "M2" << to_cv(pair->cam1->camera.K()) << "D2" << distortion(pair->cam1->camera);
+  ex.writeComment(fmt::format(
+      " Written by {}. p2 = R * p1 + T, T in metres; rectification at alpha 1.", version_string()));
+  ex << "R" << to_cv(pair->T_cam1_cam0.R) << "T" << to_cv(pair->T_cam1_cam0.t);
+  ex << "R1" << r->R1 << "R2" << r->R2 << "P1" << r->P1 << "P2" << r->P2 << "Q" << r->Q;
+  return {in.releaseAndGetString(), ex.releaseAndGetString()};
 }
 
 std::string ros_camera_info_yaml(const Rig& rig, std::string_view name) {
@@ -300,6 +340,11 @@ std::vector<io::OutputFile> export_files(const Rig& rig, ExportFormat format,
       return {{out, kalibr_camchain_yaml(rig, options)}};
     case ExportFormat::opencv:
       return {{out, opencv_yaml(rig)}};
+    case ExportFormat::opencv_sample: {
+      OpenCvSampleFiles f = opencv_sample_files(rig);
+      return {{out / "intrinsics.yml", std::move(f.intrinsics)},
+              {out / "extrinsics.yml", std::move(f.extrinsics)}};
+    }
     case ExportFormat::ros:
     case ExportFormat::mrcal: {
       std::vector<io::OutputFile> files;

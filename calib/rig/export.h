@@ -11,10 +11,11 @@
 
 namespace rigcal::rig {
 
-enum class ExportFormat { rigcal, vbr, kalibr, opencv, ros, mrcal };
+enum class ExportFormat { rigcal, vbr, kalibr, opencv, opencv_sample, ros, mrcal };
 ExportFormat export_format_from_string(std::string_view name);  // throws, listing the names
 std::string_view to_string(ExportFormat format);
-// True when the format writes one file per camera into a folder (ros, mrcal).
+// True when the format writes a folder: one file per camera (ros, mrcal), or OpenCV's stereo_calib
+// sample's two files (opencv-sample).
 bool writes_folder(ExportFormat format);
 
 struct ExportOptions {
@@ -35,6 +36,14 @@ std::string kalibr_camchain_yaml(const Rig& rig, const ExportOptions& options = 
 // alpha (balance) 0. Not the stereo_calib sample's two files (intrinsics.yml M1 D1 M2 D2,
 // extrinsics.yml), doc/exports.md.
 std::string opencv_yaml(const Rig& rig);
+// The two files OpenCV's stereo_calib sample writes, for the first two cameras: intrinsics.yml
+// (M1 D1 M2 D2) and extrinsics.yml (R T R1 R2 P1 P2 Q: p2 = R p1 + T, T in metres where the
+// sample's is in its square-size units; the rectification at alpha 1, every source pixel kept,
+// as the sample asks). Throws without a pair of the same lens model and image size.
+struct OpenCvSampleFiles {
+  std::string intrinsics, extrinsics;
+};
+OpenCvSampleFiles opencv_sample_files(const Rig& rig);
 
 // ROS camera_info YAML (camera_calibration_parsers) of one camera. With a stereo pair of equal
 // image size, the rectification and projection matrices are those of stereo rectification

@@ -29,6 +29,8 @@ fs::path export_name(rig::ExportFormat f) {
       return "camchain-imucam.yaml";
     case rig::ExportFormat::opencv:
       return "opencv_stereo.yaml";
+    case rig::ExportFormat::opencv_sample:
+      return "opencv_sample";
     case rig::ExportFormat::ros:
       return "ros";
     case rig::ExportFormat::mrcal:

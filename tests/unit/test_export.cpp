@@ -130,6 +130,45 @@ TEST(ExportOpenCV, FileStorageReadsKDRTAndRectification) {
   }
 }
 
+// OpenCV's stereo_calib sample's two files, as the sample reads them back (its keys M1 D1 M2 D2
+// and R T R1 R2 P1 P2 Q), at alpha 1: the rectified views keep every source pixel, so their
+// focal length is smaller than at alpha 0 (opencv_yaml's). One camera is refused.
+TEST(ExportOpenCv, TheStereoSamplesTwoFiles) {
+  const Rig rig = sample_rig();
+  const std::filesystem::path dir = "cv_sample";  // names only: nothing is written
+  const std::vector<io::OutputFile> files = export_files(rig, ExportFormat::opencv_sample, dir, {});
+  ASSERT_EQ(files.size(), 2u);
+  EXPECT_EQ(files[0].path, dir / "intrinsics.yml");
+  EXPECT_EQ(files[1].path, dir / "extrinsics.yml");
+  cv::FileStorage in(files[0].content, cv::FileStorage::READ | cv::FileStorage::MEMORY);
+  cv::FileStorage ex(files[1].content, cv::FileStorage::READ | cv::FileStorage::MEMORY);
+  ASSERT_TRUE(in.isOpened() && ex.isOpened());
+  EXPECT_EQ(Eigen::Matrix3d(to_eigen(read_mat(in, "M1"))), sensor(rig, "cam_l").camera.K());
+  EXPECT_EQ(Eigen::Matrix3d(to_eigen(read_mat(in, "M2"))), sensor(rig, "cam_r").camera.K());
+  EXPECT_EQ(read_mat(in, "D2").total(), sensor(rig, "cam_r").camera.distortion_coeffs.size());
+  const SE3 T_r_l = T_a_b(rig, "cam_r", "cam_l");
+  EXPECT_EQ(Eigen::Matrix3d(to_eigen(read_mat(ex, "R"))), T_r_l.R);
+  EXPECT_EQ(Eigen::Vector3d(to_eigen(read_mat(ex, "T"))), T_r_l.t);
+  for (const char* key : {"R1", "R2", "P1", "P2", "Q"})
+    EXPECT_FALSE(read_mat(ex, key).empty()) << key;
+  cv::FileStorage one(opencv_yaml(rig), cv::FileStorage::READ | cv::FileStorage::MEMORY);
+  const double f_alpha1 = read_mat(ex, "P1").at<double>(0, 0);
+  const double f_alpha0 = read_mat(one, "P1").at<double>(0, 0);
+  EXPECT_LT(f_alpha1, f_alpha0);
+  Rig mono = rig;
+  mono.sensors.erase(std::remove_if(mono.sensors.begin(), mono.sensors.end(),
+                                    [](const Sensor& s) { return s.name == "cam_r"; }),
+                     mono.sensors.end());
+  try {
+    export_files(mono, ExportFormat::opencv_sample, dir, {});
+    ADD_FAILURE() << "one camera exported as a stereo pair";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("it needs two cameras"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(writes_folder(ExportFormat::opencv_sample));
+  EXPECT_EQ(export_format_from_string("opencv-sample"), ExportFormat::opencv_sample);
+}
+
 TEST(ExportRos, CameraInfoPerCameraWithStereoRectification) {
   const Rig rig = sample_rig();
   const Sensor& cam_r = sensor(rig, "cam_r");
