@@ -1,53 +1,14 @@
 // rigcal bench: scores estimated trajectories against ground truth (doc/bench.md).
 #include <fmt/format.h>
-#include <fmt/ranges.h>
 
-#include <filesystem>
 #include <memory>
 
 #include "cli.h"
-#include "rigcal/bench/leaderboard.h"
-#include "rigcal/bench/report.h"
 #include "rigcal/bench/step.h"
-#include "rigcal/core/error.h"
 
 namespace rigcal::cli {
-namespace bench_command {
-
-void run_pair(const bench::BenchOptions& o) {
-  for (const std::string& line : bench::pair_summary(o, bench::score_pair(o)))
-    fmt::print("{}\n", line);
-}
-
-void run_several(const bench::BenchOptions& o) {
-  for (const std::string& line : bench::several_summary(o, bench::score_several(o)))
-    fmt::print("{}\n", line);
-}
-
-void run_compare(const std::vector<std::string>& results, const std::string& report) {
-  const bench::Compared compared = bench::compare_results(results, report);
-  fmt::print("{}", bench::compare_markdown(compared.results));
-  if (!report.empty())
-    fmt::print("report: {}: {}\n", report, fmt::join(compared.report_files, ", "));
-}
-
-void run_leaderboard(const bench::BenchOptions& o) {
-  const bench::Leaderboard board =
-      bench::score_leaderboard(o, [](std::string_view msg) { fmt::print(stderr, "{}\n", msg); });
-  fmt::print("{}", bench::leaderboard_markdown(board));
-  if (!o.report.empty())
-    fmt::print("report: {}/leaderboard.{{md,csv,json}} and cumulative curves\n", o.report);
-  if (bench::scored_entries(board) == 0) {
-    fmt::print(stderr,
-               "rigcal: error: no run could be scored (every estimate missing or failed)\n");
-    throw Exit{2};
-  }
-}
-
-}  // namespace bench_command
 
 void add_bench(CLI::App& app) {
-  using namespace bench_command;
   auto o = std::make_shared<bench::BenchOptions>();
   CLI::App* cmd = app.add_subcommand(
       "bench",
@@ -73,14 +34,7 @@ void add_bench(CLI::App& app) {
       "se3 | sim3 | yaw | origin | none (default: se3 for rigcal and vbr, none for evo and kitti)");
   cmd->add_option("--align-first", o->align_first,
                   "align on the first N matched poses only (0: all)")
-      // CLI11 reads '' as 0 and -1 as a huge count into an unsigned: neither is a count.
-      ->check(CLI::Validator(
-          [](std::string& s) {
-            return !s.empty() && s.find_first_not_of("0123456789") == std::string::npos
-                       ? std::string()
-                       : "expected a count of poses (0: all), got '" + s + "'";
-          },
-          "COUNT"));
+      ->check(whole_count("a count of poses (0: all)"));
   cmd->add_option("--association", o->association,
                   "interpolate | nearest | one_to_one | index (default: the convention's)");
   cmd->add_option("--max-diff", o->max_diff, "nearest / one_to_one: largest stamp difference, s")
@@ -148,15 +102,15 @@ void add_bench(CLI::App& app) {
       "folder for compare.md, .csv, .json and evo_res's plots: the ATE's and the delta\n"
       "RPE's statistics as bars; box plots and histograms where the results\n"
       "hold their distribution (bench --report writes it)");
-  compare->callback([compared, compare_report] { run_compare(*compared, *compare_report); });
-  cmd->callback([o, compare] {
+  auto print = [](std::string_view line) { fmt::print("{}\n", line); };
+  compare->callback([compared, compare_report, print] {
+    for (const std::string& line : bench::compare_summary(
+             bench::compare_results(*compared, *compare_report), *compare_report))
+      print(line);
+  });
+  cmd->callback([o, compare, print] {
     if (compare->parsed()) return;
-    if (!o->gt_dir.empty()) return run_leaderboard(*o);
-    if (o->gt.empty() || o->ests.empty())
-      throw Error("give --gt and --est (or --gt-dir and --est-dir)");
-    if (o->ests.size() > 1) return run_several(*o);
-    o->est = o->ests.front();
-    run_pair(*o);
+    bench::run_bench(*o, print, [](std::string_view msg) { fmt::print(stderr, "{}\n", msg); });
   });
 }
 

@@ -27,6 +27,17 @@ inline CLI::Validator finite_number(bool strict) {
       strict ? "POSITIVE" : "NON-NEGATIVE");
 }
 
+// Option checks for a whole count (digits only): CLI11 reads '' as 0 and -1 as a huge count into
+// an unsigned, and neither is a count. `what` names it in the message.
+inline CLI::Validator whole_count(std::string what) {
+  return CLI::Validator(
+      [what](std::string& s) -> std::string {
+        if (!s.empty() && s.find_first_not_of("0123456789") == std::string::npos) return {};
+        return "expected " + what + ", got '" + s + "'";
+      },
+      "COUNT");
+}
+
 // Option checks for a span of seconds within [min_s, max_s] (finite; a span past 1e9 s, 31 years,
 // is no recording's and would leave rigcal::Time's range).
 inline CLI::Validator seconds_within(double min_s, double max_s = 1e9) {

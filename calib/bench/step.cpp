@@ -21,6 +21,12 @@ std::string stats_line(std::string_view label, const Stats& s) {
       label, s.rmse, s.mean, s.median, s.std, s.min, s.max);
 }
 
+// A table's text as one printed line (print adds the newline).
+std::string without_final_newline(std::string text) {
+  if (!text.empty() && text.back() == '\n') text.pop_back();
+  return text;
+}
+
 }  // namespace
 
 io::TrajectoryReadOptions read_options(const BenchOptions& o, const std::string& format,
@@ -203,6 +209,34 @@ Compared compare_results(const std::vector<std::string>& paths, const std::strin
   make_names_unique(out.results);
   if (!report.empty()) out.report_files = write_compare_report(out.results, report);
   return out;
+}
+
+std::vector<std::string> compare_summary(const Compared& compared, const std::string& report) {
+  std::vector<std::string> out = {without_final_newline(compare_markdown(compared.results))};
+  if (!report.empty())
+    out.push_back(fmt::format("report: {}: {}", report, fmt::join(compared.report_files, ", ")));
+  return out;
+}
+
+void run_bench(BenchOptions o, const std::function<void(std::string_view)>& print,
+               const std::function<void(std::string_view)>& tell) {
+  if (!o.gt_dir.empty()) {
+    const Leaderboard board = score_leaderboard(o, tell);
+    print(without_final_newline(leaderboard_markdown(board)));
+    if (!o.report.empty())
+      print(fmt::format("report: {}/leaderboard.{{md,csv,json}} and cumulative curves", o.report));
+    if (scored_entries(board) == 0)
+      throw Error("no run could be scored (every estimate missing or failed)");
+    return;
+  }
+  if (o.gt.empty() || o.ests.empty())
+    throw Error("give --gt and --est (or --gt-dir and --est-dir)");
+  if (o.ests.size() > 1) {
+    for (const std::string& line : several_summary(o, score_several(o))) print(line);
+    return;
+  }
+  o.est = o.ests.front();
+  for (const std::string& line : pair_summary(o, score_pair(o))) print(line);
 }
 
 Leaderboard score_leaderboard(const BenchOptions& o,

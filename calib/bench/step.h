@@ -74,6 +74,16 @@ struct Compared {
 };
 Compared compare_results(const std::vector<std::string>& paths, const std::string& report);
 
+// What `rigcal bench compare` prints: the table, and the files written to `report`.
+std::vector<std::string> compare_summary(const Compared& compared, const std::string& report);
+
+// `rigcal bench` for its options: one pair (o.ests of one), several estimates, or the leaderboard
+// (o.gt_dir); each line to print goes to `print`, each leaderboard failure to `tell` as it
+// happens. Throws rigcal::Error when the options name no job, or, after the leaderboard's table,
+// when no run of it could be scored.
+void run_bench(BenchOptions o, const std::function<void(std::string_view)>& print,
+               const std::function<void(std::string_view)>& tell);
+
 // Loads the leaderboard's folders, scores every run (`tell` receives a line per failure) and
 // writes the report when o.report is set.
 Leaderboard score_leaderboard(const BenchOptions& o,
