@@ -152,10 +152,7 @@ TEST(CameraReal, AcfrFisheyeIsDeterminedWhereTheBoardWasAndNotBeyond) {
   }
   Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
   for (size_t i = 0; i < rays_ours.size(); ++i) H += rays_ours[i] * rays_published[i].transpose();
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
-  D(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1.0 : 1.0;
-  const Eigen::Matrix3d R_ours_published = svd.matrixU() * D * svd.matrixV().transpose();
+  const Eigen::Matrix3d R_ours_published = nearest_rotation(H);  // Kabsch: the SVD projection
   std::printf("rotation taken out: %.4f deg\n",
               Eigen::AngleAxisd(R_ours_published).angle() * 180.0 / M_PI);
   std::vector<char> seen(map.sigma_px.size(), 0);
