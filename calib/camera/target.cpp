@@ -55,6 +55,17 @@ std::vector<Eigen::Vector3d> object_points(const Target& t) {
   return pts;
 }
 
+Eigen::Vector2d board_points_extent(const Target& t) {
+  const double pitch =
+      t.type == TargetType::checkerboard ? t.square : t.tag_size * (1 + t.tag_spacing);
+  const double last = t.type == TargetType::checkerboard ? 0.0 : t.tag_size;
+  return {(t.cols - 1) * pitch + last, (t.rows - 1) * pitch + last};
+}
+
+Eigen::Vector2d board_warp_basis(const Target& t, double x, double y) {
+  return board_warp_basis(board_points_extent(t).cwiseInverse(), x, y);
+}
+
 Outline outline(const Target& t) {
   Outline o;
   if (t.type == TargetType::checkerboard) {

@@ -41,6 +41,23 @@ void validate(const Target& target);
 //     point (m, n) belongs to tag (n / 2) * cols + m / 2.
 std::vector<Eigen::Vector3d> object_points(const Target& target);
 
+// A board that is not flat, as mrcal models it (its `calobject_warp`): along x and along y a
+// parabola that is zero at the first and the last object point and `warp_m` high at the middle,
+// added to z: z = warp_m.x() * 4 xr (1 - xr) + warp_m.y() * 4 yr (1 - yr), with xr = x / (the
+// object points' extent in x), yr likewise. The two parabolas' values at board point (x, y):
+Eigen::Vector2d board_warp_basis(const Target& target, double x, double y);
+// The same with the object points' extent (x, y) given: 1 / board_points_extent(target).
+Eigen::Vector2d board_points_extent(const Target& target);
+inline Eigen::Vector2d board_warp_basis(const Eigen::Vector2d& inverse_extent, double x, double y) {
+  const double xr = x * inverse_extent.x(), yr = y * inverse_extent.y();
+  return {4 * xr * (1 - xr), 4 * yr * (1 - yr)};
+}
+// Point p of the flat board moved onto the warped one.
+inline Eigen::Vector3d warped(const Target& target, const Eigen::Vector3d& p,
+                              const Eigen::Vector2d& warp_m) {
+  return p + Eigen::Vector3d(0, 0, warp_m.dot(board_warp_basis(target, p.x(), p.y())));
+}
+
 // The physical board in the board frame: x_min..x_max, y_min..y_max (pattern plus margin).
 struct Outline {
   double x_min = 0, x_max = 0, y_min = 0, y_max = 0;

@@ -69,7 +69,8 @@ void write_simulated_session(const fs::path& dir, const rig::Rig& rig, const sim
       {"type",
        config.target.type == camera::TargetType::checkerboard ? "checkerboard" : "aprilgrid"},
       {"cols", config.target.cols},
-      {"rows", config.target.rows}};
+      {"rows", config.target.rows},
+      {"board_warp_m", {config.board_warp_m.x(), config.board_warp_m.y()}}};
   Trajectory replay;
   if (!config.replay_tum.empty()) replay = io::read_trajectory(config.replay_tum).trajectory;
   for (const std::string& part : parts) {

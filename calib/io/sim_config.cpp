@@ -89,6 +89,14 @@ void apply_sim_config(std::string_view text, std::string_view file, sim::SimConf
       {"target", Setter([&](const YAML::Node& n) {
          c.target = read_target_file(base / n.as<std::string>());
        })},
+      {"board_warp_mm", Setter([&](const YAML::Node& n) {
+         if (!n.IsSequence() || n.size() != 2)
+           throw Error("expected [x, y]: the board's warp along x and y (mm)");
+         const double x = n[0].as<double>(), y = n[1].as<double>();
+         if (!(std::abs(x) <= 100 && std::abs(y) <= 100))
+           throw Error("expected a warp within 100 mm along each axis");
+         c.board_warp_m = Eigen::Vector2d(x, y) / 1000.0;
+       })},
       {"stereo.views", integer(c.boards.views, 1, 1000)},
       {"stereo.min_fill", num(c.boards.min_fill, 0.01, 1)},
       {"stereo.max_fill", num(c.boards.max_fill, 0.01, 1)},

@@ -69,13 +69,16 @@ StereoPart simulate_stereo(const rig::Rig& rig, const SimConfig& cfg) {
       board_poses(left.camera, &right.camera, T_right_left, cfg.target, cfg.boards, rng);
   const camera::Pattern pattern(cfg.target);
   const PixelRays rays_l = pixel_rays(left.camera), rays_r = pixel_rays(right.camera);
-  const std::vector<Eigen::Vector3d> points = camera::object_points(cfg.target);
+  std::vector<Eigen::Vector3d> points = camera::object_points(cfg.target);
+  for (Eigen::Vector3d& p : points) p = camera::warped(cfg.target, p, cfg.board_warp_m);
   for (size_t k = 0; k < part.T_left_board.size(); ++k) {
     const SE3& T_l = part.T_left_board[k];
     const SE3 T_r = T_right_left * T_l;
     part.stamps.push_back(Time::from_seconds(cfg.base_start_s + k * cfg.frame_period_s));
-    part.left.push_back(render_board(rays_l, cfg.target, pattern, T_l, cfg.image, rng));
-    part.right.push_back(render_board(rays_r, cfg.target, pattern, T_r, cfg.image, rng));
+    part.left.push_back(
+        render_board(rays_l, cfg.target, pattern, T_l, cfg.image, rng, cfg.board_warp_m));
+    part.right.push_back(
+        render_board(rays_r, cfg.target, pattern, T_r, cfg.image, rng, cfg.board_warp_m));
     part.corners_left.push_back(project_points(left.camera, T_l, points));
     part.corners_right.push_back(project_points(right.camera, T_r, points));
   }
@@ -96,16 +99,17 @@ LidarCameraPart simulate_lidar_camera(const rig::Rig& rig, const SimConfig& cfg)
   part.T_camera_board = board_poses(cam.camera, nullptr, SE3(), cfg.target, boards, rng);
   const camera::Pattern pattern(cfg.target);
   const PixelRays rays = pixel_rays(cam.camera);
+  std::vector<Eigen::Vector3d> points = camera::object_points(cfg.target);
+  for (Eigen::Vector3d& p : points) p = camera::warped(cfg.target, p, cfg.board_warp_m);
   const double z_floor = -1.3, z_ceiling = 2.2;  // the LiDAR 1.3 m above the floor
   std::uniform_real_distribution<double> U(-1.0, 1.0);
   for (size_t k = 0; k < part.T_camera_board.size(); ++k) {
     const SE3 T_lidar_board = T_lidar_cam * part.T_camera_board[k];
     part.T_lidar_board.push_back(T_lidar_board);
     part.stamps.push_back(Time::from_seconds(cfg.base_start_s + 10.0 * k));
-    part.images.push_back(
-        render_board(rays, cfg.target, pattern, part.T_camera_board[k], cfg.image, rng));
-    part.corners.push_back(
-        project_points(cam.camera, part.T_camera_board[k], camera::object_points(cfg.target)));
+    part.images.push_back(render_board(rays, cfg.target, pattern, part.T_camera_board[k], cfg.image,
+                                       rng, cfg.board_warp_m));
+    part.corners.push_back(project_points(cam.camera, part.T_camera_board[k], points));
     Scene scene;
     add_room(scene, 7.0, 5.0, z_floor, z_ceiling);
     add_board(scene, cfg.target, pattern, T_lidar_board, z_floor, 1);
@@ -351,9 +355,8 @@ SweepDrive trajectory_drive(const rig::Rig& rig, const SimConfig& cfg, const Tra
   for (int i = 0; i < markers; ++i) {
     const double at_length = section_start + (i + 0.5) / markers * section;
     const size_t k = std::min<size_t>(
-        poses.size() - 1,
-        size_t(std::lower_bound(along_path.begin(), along_path.end(), at_length) -
-               along_path.begin()));
+        poses.size() - 1, size_t(std::lower_bound(along_path.begin(), along_path.end(), at_length) -
+                                 along_path.begin()));
     const size_t a = k >= 10 ? k - 10 : 0, b = std::min(k + 10, poses.size() - 1);
     Eigen::Vector2d along = (poses[b].t - poses[a].t).head<2>();
     if (along.norm() < 1e-6) along = poses[k].R.col(0).head<2>();

@@ -28,6 +28,9 @@ struct SimConfig {
   uint64_t seed = 1;
   double base_start_s = 1000.0;  // the base clock at the start (like vbr-devkit's small bag times)
   camera::Target target = default_target();
+  // The printed board's warp (camera/target.h), m; zero: flat. In the stereo and lidar-camera
+  // images (the LiDAR sees a flat board: a few mm are below its noise).
+  Eigen::Vector2d board_warp_m = Eigen::Vector2d::Zero();
   // stereo: target images seen by both cameras
   BoardPoseConfig boards;
   ImageConfig image;

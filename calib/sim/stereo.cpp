@@ -136,11 +136,34 @@ PixelRays pixel_rays(const rig::CameraModel& cam) {
 
 cv::Mat render_board(const PixelRays& rays, const camera::Target& target,
                      const camera::Pattern& pattern, const SE3& T_cam_board, const ImageConfig& cfg,
-                     std::mt19937_64& rng) {
+                     std::mt19937_64& rng, const Eigen::Vector2d& board_warp_m) {
+  const bool flat = board_warp_m.isZero();
+  // How far a warp can move where a ray meets the board: its height (the parabolas grow to 1.5
+  // times the warp at the board's edges) times the tangent of a ray's incidence (< 3: 72 deg).
+  const double reach = 5 * board_warp_m.cwiseAbs().sum();
+  const Eigen::Vector2d inverse_extent = camera::board_points_extent(target).cwiseInverse();
   const camera::Outline o = camera::outline(target);
   const Eigen::Vector3d n = T_cam_board.R.col(2), t = T_cam_board.t;
   const Eigen::Vector3d ex = T_cam_board.R.col(0), ey = T_cam_board.R.col(1);
   const double n_dot_t = n.dot(t);
+  // Where the ray meets the board's plane (false: it does not, in front of the camera).
+  auto plane_hit = [&](const Eigen::Vector3d& ray, double& bx, double& by) {
+    const double denom = n.dot(ray);
+    if (std::abs(denom) <= 1e-12 || n_dot_t / denom <= 0) return false;
+    const Eigen::Vector3d d = n_dot_t / denom * ray - t;
+    bx = ex.dot(d), by = ey.dot(d);
+    return true;
+  };
+  // A warped board: one step from board point (bx, by) to where the ray meets the plane z = w at
+  // it, w the warp there. Each step shrinks the error by the surface's slope times the ray's
+  // obliquity (< 0.1 for a few mm over A3). Returns how far the point moved.
+  auto warp_step = [&](const Eigen::Vector3d& ray, double& bx, double& by) {
+    const double w = board_warp_m.dot(camera::board_warp_basis(inverse_extent, bx, by));
+    const Eigen::Vector3d d = (n_dot_t + w) / n.dot(ray) * ray - t;
+    const double x = ex.dot(d), y = ey.dot(d), moved = std::abs(x - bx) + std::abs(y - by);
+    bx = x, by = y;
+    return moved;
+  };
   const int S = std::max(1, cfg.supersample);
   cv::Mat signal(rays.height, rays.width, CV_64F);
   const double r_corner2 =
@@ -149,22 +172,37 @@ cv::Mat render_board(const PixelRays& rays, const camera::Target& target,
     double* row = signal.ptr<double>(v);
     for (int u = 0; u < rays.width; ++u) {
       const size_t i = static_cast<size_t>(v) * rays.width + u;
+      // The warp's shift of the pixel centre's hit, converged; each sample starts from its plane
+      // hit moved by it and takes one step (the shift changes by < 0.1 mm over a pixel: one step
+      // leaves micrometres). Rays that miss the board by more than the warp can move them: none.
+      Eigen::Vector2d shift = Eigen::Vector2d::Zero();
+      bool warp_here = false;
+      if (!flat) {
+        const Eigen::Vector3d ray(rays.xn[i].x(), rays.xn[i].y(), 1.0);
+        double bx, by;
+        if (plane_hit(ray, bx, by) && bx >= o.x_min - reach && bx <= o.x_max + reach &&
+            by >= o.y_min - reach && by <= o.y_max + reach) {
+          warp_here = true;
+          double x = bx, y = by;
+          for (int k = 0; k < 10 && warp_step(ray, x, y) > 1e-8; ++k) {
+          }
+          shift = Eigen::Vector2d(x - bx, y - by);
+        }
+      }
       double sum = 0.0;
       for (int sy = 0; sy < S; ++sy) {
         for (int sx = 0; sx < S; ++sx) {
           const Eigen::Vector2d off((sx + 0.5) / S - 0.5, (sy + 0.5) / S - 0.5);
           const Eigen::Vector2d xn = rays.xn[i] + rays.dxn_dpixel[i] * off;
           const Eigen::Vector3d ray(xn.x(), xn.y(), 1.0);
-          const double denom = n.dot(ray);
-          double value = cfg.background_dn;
-          if (std::abs(denom) > 1e-12) {
-            const double lambda = n_dot_t / denom;
-            if (lambda > 0) {
-              const Eigen::Vector3d d = lambda * ray - t;
-              const double bx = ex.dot(d), by = ey.dot(d);
-              if (bx >= o.x_min && bx <= o.x_max && by >= o.y_min && by <= o.y_max) {
-                value = cfg.black_dn + (cfg.white_dn - cfg.black_dn) * pattern.albedo(bx, by);
-              }
+          double value = cfg.background_dn, bx, by;
+          if (plane_hit(ray, bx, by)) {
+            if (warp_here) {
+              bx += shift.x(), by += shift.y();
+              warp_step(ray, bx, by);
+            }
+            if (bx >= o.x_min && bx <= o.x_max && by >= o.y_min && by <= o.y_max) {
+              value = cfg.black_dn + (cfg.white_dn - cfg.black_dn) * pattern.albedo(bx, by);
             }
           }
           sum += value;

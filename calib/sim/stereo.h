@@ -50,10 +50,12 @@ struct PixelRays {
 };
 PixelRays pixel_rays(const rig::CameraModel& camera);
 
-// One 8-bit image (CV_8UC1; a raw RGGB mosaic with config.bayer) of the board at T_cam_board.
+// One 8-bit image (CV_8UC1; a raw RGGB mosaic with config.bayer) of the board at T_cam_board,
+// warped by board_warp_m (camera/target.h; zero: flat).
 cv::Mat render_board(const PixelRays& rays, const camera::Target& target,
                      const camera::Pattern& pattern, const SE3& T_cam_board,
-                     const ImageConfig& config, std::mt19937_64& rng);
+                     const ImageConfig& config, std::mt19937_64& rng,
+                     const Eigen::Vector2d& board_warp_m = Eigen::Vector2d::Zero());
 
 // The true pixel positions of the target's object points; nullopt entries behind the camera.
 std::vector<Eigen::Vector2d> project_points(const rig::CameraModel& camera, const SE3& T_cam_board,
