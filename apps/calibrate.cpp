@@ -82,9 +82,11 @@ void add_calibrate(CLI::App& app) {
                   "rerun only this step; the others from the cache where it holds them");
   cmd->add_option("--model", o->run.cameras.model,
                   "camera model: pinhole-radtan | pinhole-radtan5 | pinhole-equidistant (Kalibr's\n"
-                  "pinhole-equi), or NAME=MODEL,NAME=MODEL (one model for all cameras today)")
+                  "pinhole-equi), or per camera NAME=MODEL,NAME=MODEL")
       ->capture_default_str();
   cmd->add_option("--bayer", o->bayer, "raw Bayer images: rggb | bggr | grbg | gbrg");
+  cmd->add_flag("--board-warp", o->run.cameras.board_warp,
+                "cameras: solve the board's warp too (mrcal's calobject_warp; doc/cameras.md)");
   cmd->add_option("--lidar-camera", o->run.lidar_camera.camera,
                   "the camera of the LiDAR-camera step")
       ->capture_default_str();

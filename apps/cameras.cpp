@@ -17,6 +17,7 @@ struct Options {
   std::string target, session, model = "pinhole-radtan", rig, out, report, bayer;
   std::vector<std::string> cameras;  // NAME=GLOB
   double k_sigma = 4.0;
+  bool board_warp = false;
 };
 
 io::ImageSet images(const Options& o) {
@@ -43,6 +44,7 @@ void run(const Options& o) {
   camera::StepOptions so;
   so.model = o.model;
   so.outlier_sigma = o.k_sigma;
+  so.board_warp = o.board_warp;
   so.bayer = io::bayer_from_string(o.bayer);
   camera::StepInputs in;
   in.target = o.target;
@@ -82,7 +84,7 @@ void add_cameras(CLI::App& app) {
   cmd->add_option(
          "--model", o->model,
          "pinhole-radtan | pinhole-radtan5 | pinhole-equidistant (Kalibr's pinhole-equi);\n"
-         "or per camera: cam_l=pinhole-radtan,cam_r=pinhole-radtan (one model for all today)")
+         "or per camera: cam_l=pinhole-radtan,cam_r=pinhole-equi (fitted together)")
       ->capture_default_str();
   cmd->add_option("--rig", o->rig, "rig to update (default: a new rig of these cameras)");
   cmd->add_option("--out", o->out, "output calibration YAML")->required();
@@ -93,6 +95,10 @@ void add_cameras(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--bayer", o->bayer,
                   "raw Bayer images: rggb | bggr | grbg | gbrg (demosaiced to gray)");
+  cmd->add_flag("--board-warp", o->board_warp,
+                "solve the board's warp too (a printed board on a backing is not flat): two\n"
+                "parabolas along the board's axes, as mrcal's calobject_warp; reported with "
+                "its 1-sigma");
   cmd->callback([o] { run(*o); });
 }
 

@@ -54,17 +54,39 @@ bool residual(const T* k, bool radtan, int n_coeffs, const Eigen::Matrix<T, 3, 1
   return true;
 }
 
-// A corner seen by camera 0: intrinsics, board rotation and translation in camera 0.
+// The flat board's points and, for its warp (target.h), the two parabolas at each of them.
+struct BoardPoints {
+  std::vector<Eigen::Vector3d> p;
+  std::vector<Eigen::Vector2d> warp_basis;
+};
+
+BoardPoints board_points(const Target& target) {
+  BoardPoints b{object_points(target), {}};
+  for (const Eigen::Vector3d& p : b.p)
+    b.warp_basis.push_back(board_warp_basis(target, p.x(), p.y()));
+  return b;
+}
+
+// The corner on the board, warped by w (held at zero unless the warp is solved).
+template <typename T>
+Eigen::Matrix<T, 3, 1> on_board(const Eigen::Vector3d& p_board, const Eigen::Vector2d& basis,
+                                const T* w) {
+  Eigen::Matrix<T, 3, 1> p = p_board.cast<T>();
+  p.z() += w[0] * basis.x() + w[1] * basis.y();
+  return p;
+}
+
+// A corner seen by camera 0: intrinsics, board rotation and translation in camera 0, warp.
 template <int NK>
 struct Cam0Error {
   Eigen::Vector3d p_board;
-  Eigen::Vector2d observed;
+  Eigen::Vector2d warp_basis, observed;
   bool radtan;
   template <typename T>
-  bool operator()(const T* k, const T* q_board, const T* t_board, T* r) const {
+  bool operator()(const T* k, const T* q_board, const T* t_board, const T* w, T* r) const {
     const Eigen::Map<const Eigen::Quaternion<T>> q(q_board);
     const Eigen::Matrix<T, 3, 1> p =
-        q * p_board.cast<T>() + Eigen::Map<const Eigen::Matrix<T, 3, 1>>(t_board);
+        q * on_board(p_board, warp_basis, w) + Eigen::Map<const Eigen::Matrix<T, 3, 1>>(t_board);
     return residual(k, radtan, NK - 4, p, observed, r);
   }
 };
@@ -73,27 +95,27 @@ struct Cam0Error {
 template <int NK>
 struct CamCError {
   Eigen::Vector3d p_board;
-  Eigen::Vector2d observed;
+  Eigen::Vector2d warp_basis, observed;
   bool radtan;
   template <typename T>
-  bool operator()(const T* k, const T* q_board, const T* t_board, const T* q_c0, const T* t_c0,
-                  T* r) const {
+  bool operator()(const T* k, const T* q_board, const T* t_board, const T* w, const T* q_c0,
+                  const T* t_c0, T* r) const {
     const Eigen::Map<const Eigen::Quaternion<T>> qb(q_board), qc(q_c0);
     const Eigen::Matrix<T, 3, 1> p0 =
-        qb * p_board.cast<T>() + Eigen::Map<const Eigen::Matrix<T, 3, 1>>(t_board);
+        qb * on_board(p_board, warp_basis, w) + Eigen::Map<const Eigen::Matrix<T, 3, 1>>(t_board);
     const Eigen::Matrix<T, 3, 1> p = qc * p0 + Eigen::Map<const Eigen::Matrix<T, 3, 1>>(t_c0);
     return residual(k, radtan, NK - 4, p, observed, r);
   }
 };
 
 template <int NK>
-ceres::CostFunction* make_cost(int camera, const Eigen::Vector3d& p, const Eigen::Vector2d& uv,
-                               bool radtan) {
+ceres::CostFunction* make_cost(int camera, const Eigen::Vector3d& p, const Eigen::Vector2d& basis,
+                               const Eigen::Vector2d& uv, bool radtan) {
   if (camera == 0)
-    return new ceres::AutoDiffCostFunction<Cam0Error<NK>, 2, NK, 4, 3>(
-        new Cam0Error<NK>{p, uv, radtan});
-  return new ceres::AutoDiffCostFunction<CamCError<NK>, 2, NK, 4, 3, 4, 3>(
-      new CamCError<NK>{p, uv, radtan});
+    return new ceres::AutoDiffCostFunction<Cam0Error<NK>, 2, NK, 4, 3, 2>(
+        new Cam0Error<NK>{p, basis, uv, radtan});
+  return new ceres::AutoDiffCostFunction<CamCError<NK>, 2, NK, 4, 3, 2, 4, 3>(
+      new CamCError<NK>{p, basis, uv, radtan});
 }
 
 struct Pose {
@@ -126,13 +148,16 @@ struct Lens {
   int n_coeffs = 4;
   int intrinsics_size() const { return 4 + n_coeffs; }
 };
+using Lenses = std::vector<Lens>;  // one a camera
 
 // The parameters of the joint problem, changed in place by the solves.
 struct Parameters {
   std::vector<std::vector<double>> intr;   // per camera: its intrinsics block
   std::vector<Pose> cam_pose;              // per camera: T_c_0 (camera 0: identity, not solved)
   std::vector<std::optional<Pose>> board;  // per frame: T_0_board (none: no camera saw it)
-  bool hold_cameras = false;               // intrinsics and camera poses held: boards alone
+  Eigen::Vector2d warp = Eigen::Vector2d::Zero();  // the board's, m (target.h)
+  bool solve_warp = false;                         // else held at zero
+  bool hold_cameras = false;  // intrinsics and camera poses held: boards (and warp) alone
 };
 
 // Throws rigcal::Error without cameras or when they differ in frame count.
@@ -148,11 +173,25 @@ void check_frames_pair_up(const std::vector<CameraInput>& cams) {
 }
 
 // Throws rigcal::Error on a radtan model of neither 4 nor 5 coefficients.
-Lens lens_of(const CalibrationOptions& opt) {
-  const bool radtan = opt.model == rig::DistortionModel::radtan;
-  const int n_coeffs = radtan ? opt.radtan_coefficients : 4;
+Lens lens_of(rig::DistortionModel model, int radtan_coefficients) {
+  const bool radtan = model == rig::DistortionModel::radtan;
+  const int n_coeffs = radtan ? radtan_coefficients : 4;
   if (radtan && n_coeffs != 4 && n_coeffs != 5) throw Error("radtan takes 4 or 5 coefficients");
   return {radtan, n_coeffs};
+}
+
+// Each camera's lens: its own (CalibrationOptions::per_camera) or the common one. Throws
+// rigcal::Error when per_camera does not name one lens a camera.
+Lenses lenses_of(const CalibrationOptions& opt, size_t n_cams) {
+  if (!opt.per_camera.empty() && opt.per_camera.size() != n_cams)
+    throw Error(fmt::format("{} lens models for {} cameras", opt.per_camera.size(), n_cams));
+  Lenses lenses;
+  for (size_t c = 0; c < n_cams; ++c) {
+    lenses.push_back(opt.per_camera.empty()
+                         ? lens_of(opt.model, opt.radtan_coefficients)
+                         : lens_of(opt.per_camera[c].model, opt.per_camera[c].radtan_coefficients));
+  }
+  return lenses;
 }
 
 // One camera alone by OpenCV's calibration: its initial intrinsics block, and in T_c_board the
@@ -282,28 +321,33 @@ std::vector<CornerResidual> corner_residuals(const std::vector<CameraInput>& cam
 
 // One solve of the joint problem over the inlier corners, in `problem` (robust: Huber loss of
 // huber_px). Throws rigcal::Error when the solution is not usable.
-void solve(const std::vector<CornerResidual>& residuals, const std::vector<Eigen::Vector3d>& object,
-           const Lens& lens, bool robust, double huber_px, Parameters& x, ceres::Problem& problem) {
-  const bool radtan = lens.radtan;
-  const int NK = lens.intrinsics_size();
+void solve(const std::vector<CornerResidual>& residuals, const BoardPoints& object,
+           const Lenses& lenses, bool robust, double huber_px, Parameters& x,
+           ceres::Problem& problem) {
   std::vector<std::vector<double>>& intr = x.intr;
   std::vector<Pose>& cam_pose = x.cam_pose;
   std::vector<std::optional<Pose>>& board = x.board;
   for (const CornerResidual& cr : residuals) {
     if (cr.outlier) continue;
-    const Eigen::Vector3d& p = object[cr.point];
-    ceres::CostFunction* cost = NK == 8 ? make_cost<8>(cr.camera, p, cr.observed, radtan)
-                                        : make_cost<9>(cr.camera, p, cr.observed, radtan);
+    const Eigen::Vector3d& p = object.p[cr.point];
+    const Eigen::Vector2d& basis = object.warp_basis[cr.point];
+    const bool radtan = lenses[cr.camera].radtan;
+    ceres::CostFunction* cost = lenses[cr.camera].intrinsics_size() == 8
+                                    ? make_cost<8>(cr.camera, p, basis, cr.observed, radtan)
+                                    : make_cost<9>(cr.camera, p, basis, cr.observed, radtan);
     ceres::LossFunction* loss = robust ? new ceres::HuberLoss(huber_px) : nullptr;
     Pose& b = *board[cr.frame];
     if (cr.camera == 0) {
-      problem.AddResidualBlock(cost, loss, intr[0].data(), b.q.coeffs().data(), b.t.data());
+      problem.AddResidualBlock(cost, loss, intr[0].data(), b.q.coeffs().data(), b.t.data(),
+                               x.warp.data());
     } else {
       Pose& cp = cam_pose[cr.camera];
       problem.AddResidualBlock(cost, loss, intr[cr.camera].data(), b.q.coeffs().data(), b.t.data(),
-                               cp.q.coeffs().data(), cp.t.data());
+                               x.warp.data(), cp.q.coeffs().data(), cp.t.data());
     }
   }
+  if (!x.solve_warp && problem.HasParameterBlock(x.warp.data()))
+    problem.SetParameterBlockConstant(x.warp.data());
   for (auto& b : board) {
     if (b && problem.HasParameterBlock(b->q.coeffs().data())) {
       problem.SetManifold(b->q.coeffs().data(), new ceres::EigenQuaternionManifold);
@@ -335,14 +379,15 @@ void solve(const std::vector<CornerResidual>& residuals, const std::vector<Eigen
 }
 
 // Every corner's residual (outliers too) at the parameters x.
-void update_residuals(std::vector<CornerResidual>& residuals,
-                      const std::vector<Eigen::Vector3d>& object, const Lens& lens,
-                      const Parameters& x) {
+void update_residuals(std::vector<CornerResidual>& residuals, const BoardPoints& object,
+                      const Lenses& lenses, const Parameters& x) {
   for (CornerResidual& cr : residuals) {
     const Pose& b = *x.board[cr.frame];
-    Eigen::Vector3d p = b.q * object[cr.point] + b.t;
+    Eigen::Vector3d p =
+        b.q * on_board(object.p[cr.point], object.warp_basis[cr.point], x.warp.data()) + b.t;
     if (cr.camera > 0) p = x.cam_pose[cr.camera].q * p + x.cam_pose[cr.camera].t;
     Eigen::Vector2d uv;
+    const Lens& lens = lenses[cr.camera];
     project_with(x.intr[cr.camera].data(), lens.radtan, lens.n_coeffs, p.data(), uv.data());
     cr.residual = uv - cr.observed;
   }
@@ -350,13 +395,12 @@ void update_residuals(std::vector<CornerResidual>& residuals,
 
 // Robust solves, each followed by flagging the corners with a coordinate beyond
 // outlier_k_sigma robust sigmas, until none is flagged or max_rejection_rounds.
-void reject_outliers(std::vector<CornerResidual>& residuals,
-                     const std::vector<Eigen::Vector3d>& object, const Lens& lens,
-                     const CalibrationOptions& opt, Parameters& x) {
+void reject_outliers(std::vector<CornerResidual>& residuals, const BoardPoints& object,
+                     const Lenses& lenses, const CalibrationOptions& opt, Parameters& x) {
   for (int round = 0; round < opt.max_rejection_rounds; ++round) {
     ceres::Problem problem;
-    solve(residuals, object, lens, true, opt.huber_px, x, problem);
-    update_residuals(residuals, object, lens, x);
+    solve(residuals, object, lenses, true, opt.huber_px, x, problem);
+    update_residuals(residuals, object, lenses, x);
     std::vector<double> coords;
     for (const CornerResidual& cr : residuals) {
       if (!cr.outlier) coords.push_back(cr.residual.x()), coords.push_back(cr.residual.y());
@@ -372,8 +416,7 @@ void reject_outliers(std::vector<CornerResidual>& residuals,
 }
 
 // The residual statistics of the inliers, the parameter count and the noise level.
-void fit_statistics(CalibrationResult& res, size_t n_cams, int NK,
-                    const std::vector<std::optional<Pose>>& board) {
+void fit_statistics(CalibrationResult& res, const Parameters& x) {
   double sse = 0.0;
   size_t n_in = 0;
   for (const CornerResidual& cr : res.residuals) {
@@ -387,27 +430,36 @@ void fit_statistics(CalibrationResult& res, size_t n_cams, int NK,
   res.rms_2d_px = std::sqrt(sse / n_in);
   res.rms_coord_px = std::sqrt(sse / (2.0 * n_in));
   res.n_residuals = 2 * n_in;
-  res.n_parameters = n_cams * NK + 6 * (n_cams - 1);
-  for (const auto& b : board) res.n_parameters += b ? 6 : 0;
+  res.n_parameters = 6 * (x.intr.size() - 1);
+  for (const std::vector<double>& k : x.intr) res.n_parameters += k.size();
+  for (const auto& b : x.board) res.n_parameters += b ? 6 : 0;
+  res.n_parameters += x.solve_warp ? 2 : 0;
   const double dof = static_cast<double>(res.n_residuals) - static_cast<double>(res.n_parameters);
   res.noise_sigma_px = std::sqrt(sse / std::max(1.0, dof));
 }
 
 // The covariance of intrinsics, camera poses and board poses (res.covariance,
 // res.board_covariance_index), scaled by the estimated noise; a note when it cannot be computed.
-void add_covariance(CalibrationResult& res, ceres::Problem& problem, size_t n_cams, int NK,
-                    Parameters& x) {
+void add_covariance(CalibrationResult& res, ceres::Problem& problem, Parameters& x) {
+  const size_t n_cams = x.intr.size();
   const size_t n_frames = x.board.size();
   std::vector<std::vector<double>>& intr = x.intr;
   std::vector<Pose>& cam_pose = x.cam_pose;
   std::vector<std::optional<Pose>>& board = x.board;
   std::vector<const double*> blocks;
-  for (size_t c = 0; c < n_cams; ++c) blocks.push_back(intr[c].data());
+  int n_cov = 0;
+  for (size_t c = 0; c < n_cams; ++c) {
+    blocks.push_back(intr[c].data());
+    res.intrinsics_covariance_index.push_back(n_cov);
+    n_cov += static_cast<int>(intr[c].size());
+  }
+  res.pose_covariance_index.assign(n_cams, -1);
   for (size_t c = 1; c < n_cams; ++c) {
     blocks.push_back(cam_pose[c].q.coeffs().data());
     blocks.push_back(cam_pose[c].t.data());
+    res.pose_covariance_index[c] = n_cov;
+    n_cov += 6;
   }
-  int n_cov = static_cast<int>(n_cams) * NK + 6 * (static_cast<int>(n_cams) - 1);
   res.board_covariance_index.assign(n_frames, -1);
   for (size_t f = 0; f < n_frames; ++f) {
     if (!board[f] || !problem.HasParameterBlock(board[f]->q.coeffs().data())) continue;
@@ -415,6 +467,11 @@ void add_covariance(CalibrationResult& res, ceres::Problem& problem, size_t n_ca
     n_cov += 6;
     blocks.push_back(board[f]->q.coeffs().data());
     blocks.push_back(board[f]->t.data());
+  }
+  if (x.solve_warp) {
+    res.warp_covariance_index = n_cov;
+    n_cov += 2;
+    blocks.push_back(x.warp.data());
   }
   // Sparse QR first (fast on hundreds of board poses); dense SVD, which copes with a rank-deficient
   // problem, when it fails.
@@ -441,18 +498,20 @@ void add_covariance(CalibrationResult& res, ceres::Problem& problem, size_t n_ca
 }
 
 // Camera c's model, intrinsics stddev and per-view RMS.
-CameraResult camera_result(const CalibrationResult& res, const CameraInput& cam, size_t c, int NK,
-                           const std::vector<double>& intr, rig::DistortionModel model) {
+CameraResult camera_result(const CalibrationResult& res, const CameraInput& cam, size_t c,
+                           const std::vector<double>& intr, const Lens& lens) {
   const size_t n_frames = cam.frames.size();
   CameraResult cr;
   rig::CameraModel& m = cr.model;
   m.fx = intr[0], m.fy = intr[1], m.cx = intr[2], m.cy = intr[3];
-  m.distortion_model = model;
+  m.distortion_model =
+      lens.radtan ? rig::DistortionModel::radtan : rig::DistortionModel::equidistant;
   m.distortion_coeffs.assign(intr.begin() + 4, intr.end());
   m.width = cam.width;
   m.height = cam.height;
-  for (int i = 0; i < NK; ++i)
-    cr.stddev.push_back(std::sqrt(std::max(0.0, res.covariance(c * NK + i, c * NK + i))));
+  const int at = res.intrinsics_covariance_index[c];
+  for (int i = at; i < at + lens.intrinsics_size(); ++i)
+    cr.stddev.push_back(std::sqrt(std::max(0.0, res.covariance(i, i))));
   std::vector<double> sse_f(n_frames, 0.0);
   std::vector<int> n_f(n_frames, 0);
   for (const CornerResidual& r : res.residuals) {
@@ -469,14 +528,13 @@ CameraResult camera_result(const CalibrationResult& res, const CameraInput& cam,
 }
 
 // T_cam_cam0 of camera c and its 1-sigma in deg and m (camera 0: identity, 0).
-void add_camera_pose(CalibrationResult& res, size_t c, size_t n_cams, int NK,
-                     const std::vector<Pose>& cam_pose) {
+void add_camera_pose(CalibrationResult& res, size_t c, const std::vector<Pose>& cam_pose) {
   res.T_cam_cam0.push_back(c == 0 ? SE3() : cam_pose[c].se3());
   if (c == 0) {
     res.rotation_stddev_deg.emplace_back(0, 0, 0);
     res.translation_stddev_m.emplace_back(0, 0, 0);
   } else {
-    const int base = static_cast<int>(n_cams) * NK + 6 * (static_cast<int>(c) - 1);
+    const int base = res.pose_covariance_index[c];
     Eigen::Vector3d r, t;
     for (int i = 0; i < 3; ++i) {
       // Ceres' quaternion tangent: q + d = [cos|d|, sin|d| d/|d|] q, a rotation of 2|d|.
@@ -499,32 +557,37 @@ std::vector<double> intrinsics_vector(const rig::CameraModel& m) {
 CalibrationResult calibrate(const Target& target, const std::vector<CameraInput>& cams,
                             const CalibrationOptions& opt) {
   check_frames_pair_up(cams);
-  const Lens lens = lens_of(opt);
-  const int NK = lens.intrinsics_size();
-  const std::vector<Eigen::Vector3d> object = object_points(target);
+  const Lenses lenses = lenses_of(opt, cams.size());
+  const BoardPoints object = board_points(target);
 
   // ---- initialization, per camera: OpenCV's calibration gives intrinsics and board poses ----
   Parameters x;
   std::vector<std::vector<std::optional<SE3>>> T_c_board(cams.size());
   for (size_t c = 0; c < cams.size(); ++c)
-    x.intr.push_back(initial_intrinsics(cams[c], object, lens, opt.min_views, T_c_board[c]));
+    x.intr.push_back(initial_intrinsics(cams[c], object.p, lenses[c], opt.min_views, T_c_board[c]));
   x.cam_pose = camera_poses(cams, T_c_board);
   x.board = board_poses(T_c_board, x.cam_pose);
+  x.solve_warp = opt.board_warp;
 
   // ---- the joint problem, with outlier rejection ----
   CalibrationResult res;
   res.residuals = corner_residuals(cams, x.board);
-  reject_outliers(res.residuals, object, lens, opt, x);
+  reject_outliers(res.residuals, object, lenses, opt, x);
   // Final: plain least squares on the inliers, kept for the covariance.
   ceres::Problem problem;
-  solve(res.residuals, object, lens, false, opt.huber_px, x, problem);
-  update_residuals(res.residuals, object, lens, x);
-  fit_statistics(res, cams.size(), NK, x.board);
-  add_covariance(res, problem, cams.size(), NK, x);
+  solve(res.residuals, object, lenses, false, opt.huber_px, x, problem);
+  update_residuals(res.residuals, object, lenses, x);
+  fit_statistics(res, x);
+  add_covariance(res, problem, x);
+  if (x.solve_warp) {
+    res.board_warp_m = x.warp;
+    const int i = res.warp_covariance_index;
+    res.board_warp_stddev_m = res.covariance.diagonal().segment<2>(i).cwiseMax(0.0).cwiseSqrt();
+  }
 
   for (size_t c = 0; c < cams.size(); ++c) {
-    res.cameras.push_back(camera_result(res, cams[c], c, NK, x.intr[c], opt.model));
-    add_camera_pose(res, c, cams.size(), NK, x.cam_pose);
+    res.cameras.push_back(camera_result(res, cams[c], c, x.intr[c], lenses[c]));
+    add_camera_pose(res, c, x.cam_pose);
   }
   for (const auto& b : x.board)
     res.T_cam0_board.push_back(b ? std::optional<SE3>(b->se3()) : std::nullopt);
@@ -537,15 +600,18 @@ FitAtStored fit_at_stored(const Target& target, const std::vector<CameraInput>& 
   check_frames_pair_up(cams);
   if (models.size() != cams.size() || T_cam_cam0.size() != cams.size())
     throw std::invalid_argument("fit_at_stored: one model and one pose a camera");
-  const Lens lens{models[0].distortion_model == rig::DistortionModel::radtan,
-                  static_cast<int>(models[0].distortion_coeffs.size())};
+  Lenses lenses;
   for (const rig::CameraModel& m : models) {
-    if ((m.distortion_model == rig::DistortionModel::radtan) != lens.radtan ||
-        static_cast<int>(m.distortion_coeffs.size()) != lens.n_coeffs ||
-        (lens.n_coeffs != 4 && lens.n_coeffs != 5))
-      throw Error("the stored cameras' lens models differ: they cannot be fitted together");
+    const bool radtan = m.distortion_model == rig::DistortionModel::radtan;
+    const int n = static_cast<int>(m.distortion_coeffs.size());
+    const bool known = radtan ? n == 4 || n == 5
+                              : m.distortion_model == rig::DistortionModel::equidistant && n == 4;
+    if (!known)
+      throw Error(fmt::format("a stored camera's lens ({}, {} coefficients) cannot be fitted",
+                              rig::to_string(m.distortion_model), n));
+    lenses.push_back({radtan, n});
   }
-  const std::vector<Eigen::Vector3d> object = object_points(target);
+  const BoardPoints object = board_points(target);
   // Each detected board's pose in each camera from its undistorted corners (PnP), as the start.
   std::vector<std::vector<std::optional<SE3>>> T_c_board(cams.size());
   for (size_t c = 0; c < cams.size(); ++c) {
@@ -556,7 +622,7 @@ FitAtStored fit_at_stored(const Target& target, const std::vector<CameraInput>& 
       std::vector<cv::Point3d> obj;
       std::vector<cv::Point2d> img;
       for (size_t i = 0; i < d.pixels.size(); ++i) {
-        const Eigen::Vector3d& p = object[d.point_ids[i]];
+        const Eigen::Vector3d& p = object.p[d.point_ids[i]];
         const Eigen::Vector2d xn = unproject(models[c], d.pixels[i]);
         obj.emplace_back(p.x(), p.y(), p.z());
         img.emplace_back(xn.x(), xn.y());
@@ -572,13 +638,14 @@ FitAtStored fit_at_stored(const Target& target, const std::vector<CameraInput>& 
   for (size_t c = 1; c < cams.size(); ++c) x.cam_pose[c] = Pose::from(T_cam_cam0[c]);
   x.board = board_poses(T_c_board, x.cam_pose);
   x.hold_cameras = true;
+  x.solve_warp = opt.board_warp;
   CalibrationResult res;
   res.residuals = corner_residuals(cams, x.board);
   if (res.residuals.empty()) throw Error("no detected board to fit the stored cameras to");
-  reject_outliers(res.residuals, object, lens, opt, x);
+  reject_outliers(res.residuals, object, lenses, opt, x);
   ceres::Problem problem;
-  solve(res.residuals, object, lens, false, opt.huber_px, x, problem);
-  update_residuals(res.residuals, object, lens, x);
+  solve(res.residuals, object, lenses, false, opt.huber_px, x, problem);
+  update_residuals(res.residuals, object, lenses, x);
   FitAtStored out;
   double sse = 0;
   std::vector<double> camera_sse(cams.size(), 0.0);

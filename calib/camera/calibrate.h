@@ -23,11 +23,20 @@ struct CameraInput {
 
 struct CalibrationOptions {
   rig::DistortionModel model = rig::DistortionModel::radtan;
-  int radtan_coefficients = 4;   // 4 (k1 k2 p1 p2) or 5 (+ k3)
+  int radtan_coefficients = 4;  // 4 (k1 k2 p1 p2) or 5 (+ k3)
+  // One lens a camera, in the cameras' order, when they differ (empty: `model` for all).
+  struct Lens {
+    rig::DistortionModel model = rig::DistortionModel::radtan;
+    int radtan_coefficients = 4;
+  };
+  std::vector<Lens> per_camera;
   double outlier_k_sigma = 4.0;  // drop corners with a residual coordinate beyond k sigma
   int max_rejection_rounds = 5;
   double huber_px = 1.0;  // robust loss while outliers are rejected
   int min_views = 3;
+  // Solve the board's warp too (target.h: two parabolas, as mrcal's calobject_warp): a printed
+  // board on a backing is not flat. Off: the board is taken as flat.
+  bool board_warp = false;
 };
 
 struct CornerResidual {
@@ -53,7 +62,8 @@ struct FitAtStored {
   size_t corners = 0, outliers = 0, views = 0;
 };
 // `models` and `T_cam_cam0` (camera 0: identity) one a camera, in the order of `cams`; the models
-// share one lens type. Throws rigcal::Error when they do not or no board was detected.
+// may differ in lens model. Throws rigcal::Error on a lens it cannot fit or when no board was
+// detected.
 FitAtStored fit_at_stored(const Target& target, const std::vector<CameraInput>& cams,
                           const std::vector<rig::CameraModel>& models,
                           const std::vector<SE3>& T_cam_cam0, const CalibrationOptions& options);
@@ -70,11 +80,17 @@ struct CalibrationResult {
   double noise_sigma_px = 0;  // per coordinate, from the residuals and the degrees of freedom
   size_t n_outliers = 0, n_parameters = 0, n_residuals = 0;
   // Of every parameter, tangent space, scaled by noise_sigma_px^2: the intrinsics of each camera
-  // (camera c at c * NK), then T_cami_cam0 for i >= 1 (3 rotation + 3 translation each), then
+  // (camera c's at intrinsics_covariance_index[c], as many as its stddev), then T_cami_cam0 for
+  // i >= 1 (3 rotation + 3 translation each, at pose_covariance_index[i]; -1 for camera 0), then
   // the board pose T_cam0_board of frame f at board_covariance_index[f] (-1: no pose). Rotation
   // tangents are Ceres' quaternion ones: d rotates by 2|d| about d, on the left.
   Eigen::MatrixXd covariance;
+  std::vector<int> intrinsics_covariance_index, pose_covariance_index;
   std::vector<int> board_covariance_index;
+  // With CalibrationOptions::board_warp: the warp (x, y, m), its 1-sigma, and its place in the
+  // covariance (after the board poses; -1 without).
+  std::optional<Eigen::Vector2d> board_warp_m, board_warp_stddev_m;
+  int warp_covariance_index = -1;
   std::vector<std::string> notes;
 };
 

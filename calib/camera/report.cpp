@@ -100,6 +100,10 @@ nlohmann::json cameras_json(const CalibrationResult& r, const CameraReportInput&
   j["n_residuals"] = r.n_residuals;
   j["n_parameters"] = r.n_parameters;
   j["n_outliers"] = r.n_outliers;
+  if (r.board_warp_m) {
+    j["board_warp_m"] = {r.board_warp_m->x(), r.board_warp_m->y()};
+    j["board_warp_stddev_m"] = {r.board_warp_stddev_m->x(), r.board_warp_stddev_m->y()};
+  }
   j["definitions"] = {
       {"rms_2d_px", "sqrt(mean over inlier corners of |projected - observed|^2): OpenCV's RMS"},
       {"rms_per_coordinate_px",
@@ -108,6 +112,10 @@ nlohmann::json cameras_json(const CalibrationResult& r, const CameraReportInput&
        "sqrt(sum of squared residuals / (residuals - parameters)), per coordinate; scales the "
        "covariance"},
       {"stddev", "1-sigma of each parameter from the covariance"},
+      {"board_warp_m",
+       "with --board-warp: the board's bend along its x and y axes, each a parabola zero at the "
+       "first and last corner and this high (m, along the board's z) at the middle: mrcal's "
+       "calobject_warp"},
       {"projection_uncertainty",
        "worst-direction 1-sigma of a pixel's projection at uncertainty_distance_m, as mrcal "
        "defines it: the point fixed in the boards' frames, every parameter (intrinsics, camera "

@@ -52,6 +52,7 @@ CalibrationOptions calibration_options(const StepOptions& o,
                                        const std::vector<std::string>& names) {
   CalibrationOptions c;
   c.outlier_k_sigma = o.outlier_sigma;
+  c.board_warp = o.board_warp;
   if (o.model.find('=') == std::string::npos) {
     set_model(o.model, c);
     return c;
@@ -67,23 +68,14 @@ CalibrationOptions calibration_options(const StepOptions& o,
           fmt::format("--model: no camera '{}' (the cameras: {})", name, fmt::join(names, ", ")));
     per_camera[name] = std::string(item.substr(eq + 1));
   }
-  std::optional<CalibrationOptions> first;
   for (const std::string& name : names) {
     const auto it = per_camera.find(name);
     if (it == per_camera.end()) throw Error(fmt::format("--model: no model for camera '{}'", name));
     CalibrationOptions one = c;
     set_model(it->second, one);
-    if (first &&
-        (one.model != first->model || one.radtan_coefficients != first->radtan_coefficients)) {
-      throw Error(fmt::format(
-          "--model {}: the cameras are fitted together with one lens model today; different "
-          "models per camera are not supported yet (calibrate each camera on its own with its "
-          "model, then the pair with one model)",
-          o.model));
-    }
-    if (!first) first = one;
+    c.per_camera.push_back({one.model, one.radtan_coefficients});
   }
-  return *first;
+  return c;
 }
 
 struct Detections {
@@ -186,6 +178,13 @@ std::vector<std::string> summary_lines(const std::vector<std::string>& names,
       "RMS reprojection error: {:.4f} px per corner (2-D, OpenCV's), {:.4f} px per coordinate "
       "(mrcal's); {} outlier corners of {}",
       r.rms_2d_px, r.rms_coord_px, r.n_outliers, r.residuals.size()));
+  if (r.board_warp_m) {
+    out.push_back(fmt::format(
+        "board warp: {:.2f} ± {:.2f} mm along x, {:.2f} ± {:.2f} mm along y (the height of each "
+        "parabola at the board's middle)",
+        1e3 * r.board_warp_m->x(), 1e3 * r.board_warp_stddev_m->x(), 1e3 * r.board_warp_m->y(),
+        1e3 * r.board_warp_stddev_m->y()));
+  }
   for (size_t c = 0; c < names.size(); ++c) {
     const auto& m = r.cameras[c].model;
     const auto& s = r.cameras[c].stddev;
@@ -303,13 +302,13 @@ report::StepResult calibrate_cameras(const StepInputs& in, const StepOptions& o,
     if (T) distances.push_back(T->t.norm());
   }
   rep.uncertainty_distance_m = median(distances);
-  const int nk = static_cast<int>(r.cameras[0].stddev.size());
   for (size_t c = 0; c < n_cams; ++c) {
     rep.uncertainty.push_back(
         projection_uncertainty(r, static_cast<int>(c), rep.uncertainty_distance_m));
+    const int at = r.intrinsics_covariance_index[c],
+              nk = static_cast<int>(r.cameras[c].stddev.size());
     rep.uncertainty_intrinsics_only.push_back(projection_uncertainty_intrinsics_only(
-        r.cameras[c].model, r.covariance.block(c * nk, c * nk, nk, nk),
-        rep.uncertainty_distance_m));
+        r.cameras[c].model, r.covariance.block(at, at, nk, nk), rep.uncertainty_distance_m));
   }
   out.report = cameras_json(r, rep);
   std::optional<FitAtStored> at_rig;
@@ -406,24 +405,26 @@ report::StepResult calibrate_cameras(const StepInputs& in, const StepOptions& o,
                    {"outlier_corners", static_cast<double>(r.n_outliers), ""},
                    {"corners", static_cast<double>(r.residuals.size()), ""}};
   if (at_rig) out.residuals.push_back({"rms_2d_at_rig_px", at_rig->rms_2d_px, "px"});
+  if (r.board_warp_m) {
+    out.sigmas.push_back({"board_warp.x", r.board_warp_stddev_m->x(), "m"});
+    out.sigmas.push_back({"board_warp.y", r.board_warp_stddev_m->y(), "m"});
+  }
   // The sigmas and their correlations, from the blocks of the solve's covariance: each lens's
   // fx fy cx cy, then each camera pose after camera 0's (its rotation tangent is Ceres'
   // quaternion one, half the angle: scaled to rigcal's).
   static const char* kIntrinsics[] = {"fx", "fy", "cx", "cy"};
-  const Eigen::Index NK = static_cast<Eigen::Index>(r.cameras[0].stddev.size());
   for (size_t c = 0; c < n_cams; ++c) {
     std::vector<std::string> keys;
     for (int i = 0; i < 4; ++i) {
       keys.push_back(fmt::format("{}.{}", names[c], kIntrinsics[i]));
       out.sigmas.push_back({keys.back(), r.cameras[c].stddev[i], "px"});
     }
-    const Eigen::Index at = static_cast<Eigen::Index>(c) * NK;
+    const Eigen::Index at = r.intrinsics_covariance_index[c];
     out.correlations.push_back(
         report::correlation_of(names[c], keys, r.covariance.block(at, at, 4, 4)));
   }
   for (size_t c = 1; c < n_cams; ++c) {
-    const Eigen::Index at =
-        static_cast<Eigen::Index>(n_cams) * NK + 6 * static_cast<Eigen::Index>(c - 1);
+    const Eigen::Index at = r.pose_covariance_index[c];
     Eigen::Matrix<double, 6, 6> covariance = r.covariance.block(at, at, 6, 6);
     covariance.topRows<3>() *= 2.0;
     covariance.leftCols<3>() *= 2.0;

@@ -14,9 +14,10 @@ namespace rigcal::camera {
 
 struct StepOptions {
   // pinhole-radtan | pinhole-radtan5 | pinhole-equidistant (Kalibr's pinhole-equi), or
-  // NAME=MODEL,NAME=MODEL naming every camera (the same model for all: one lens model is fitted).
+  // NAME=MODEL,NAME=MODEL naming every camera (each its own lens model, fitted together).
   std::string model = "pinhole-radtan";
   double outlier_sigma = 4.0;         // corners beyond this many sigma are dropped
+  bool board_warp = false;            // solve the board's warp (calibrate.h)
   io::Bayer bayer = io::Bayer::none;  // raw mosaics: demosaiced to gray
   // Also the detections fitted to the given rig's lenses and stereo poses, only the boards free
   // (rigcal check: the new data at the stored calibration): the report's `at_rig` and the

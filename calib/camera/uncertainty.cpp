@@ -66,7 +66,6 @@ UncertaintyMap projection_uncertainty(const CalibrationResult& res, int camera, 
   const rig::CameraModel& model = res.cameras.at(camera).model;
   UncertaintyMap map = empty_map(model, cell_px);
   const int nk = static_cast<int>(res.cameras[camera].stddev.size());
-  const int n_cams = static_cast<int>(res.cameras.size());
   const Eigen::MatrixXd& cov = res.covariance;
   std::vector<int> frames;
   for (size_t f = 0; f < res.board_covariance_index.size(); ++f) {
@@ -87,9 +86,9 @@ UncertaintyMap projection_uncertainty(const CalibrationResult& res, int camera, 
         A.col(i) = (*project(model, p_c + dp) - *project(model, p_c - dp)) / (2 * h);
       }
       Eigen::MatrixXd J = Eigen::MatrixXd::Zero(2, cov.rows());
-      J.block(0, camera * nk, 2, nk) = intrinsics_jacobian(model, p_c);
+      J.block(0, res.intrinsics_covariance_index[camera], 2, nk) = intrinsics_jacobian(model, p_c);
       if (camera > 0) {  // p_c = exp(2 d) R p_0 + t
-        const int base = n_cams * nk + 6 * (camera - 1);
+        const int base = res.pose_covariance_index[camera];
         J.block<2, 3>(0, base) = A * (-2.0 * skew(T_c_0.R * p_0));
         J.block<2, 3>(0, base + 3) = A;
       }

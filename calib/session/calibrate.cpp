@@ -247,8 +247,9 @@ std::vector<Plan> make_plans(const CalibrateOptions& o, const io::Session& s,
     }
     p.reads = {"cam_l", "cam_r"};
     p.options =
-        fmt::format("model {} outlier_sigma {} bayer {} fit_at_rig {}", o.cameras.model,
-                    o.cameras.outlier_sigma, io::to_string(o.cameras.bayer), o.cameras.fit_at_rig);
+        fmt::format("model {} outlier_sigma {} bayer {} fit_at_rig {} board_warp {}",
+                    o.cameras.model, o.cameras.outlier_sigma, io::to_string(o.cameras.bayer),
+                    o.cameras.fit_at_rig, o.cameras.board_warp);
     p.reuse_detections = std::make_shared<bool>(false);
     p.run = [rec, target, out, opt = o.cameras, reuse = p.reuse_detections](
                 const rig::Rig& rig, const report::Progress& pr) {

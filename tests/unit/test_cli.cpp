@@ -675,8 +675,9 @@ TEST_F(Cli, CamerasErrorsAreOneLineAndWriteNothing) {
   EXPECT_FALSE(fs::exists(report));
 }
 
-// --model by rigcal's names or Kalibr's, for all cameras or each by name; what the solver cannot
-// fit (different models per camera, Kalibr's models without a counterpart) refused, named.
+// --model by rigcal's names or Kalibr's, for all cameras or each by name (different models per
+// camera fitted together: each lens as when both cameras have its model, the rig and the report
+// with both); Kalibr's models without a counterpart refused, named.
 TEST_F(Cli, CamerasModelNamesKalibrsAndPerCamera) {
   RIGCAL_REQUIRE_FIXTURE(dir, "stereo/opencv_samples");
   const std::string out = (dir_ / "calib.yaml").string(), report = (dir_ / "report").string();
@@ -691,12 +692,37 @@ TEST_F(Cli, CamerasModelNamesKalibrsAndPerCamera) {
     EXPECT_EQ(rigcal::rig::sensor(calib, cam).camera.distortion_model,
               rigcal::rig::DistortionModel::equidistant);
   }
+  const auto fx = [&](const char* cam) {
+    return rigcal::rig::sensor(rigcal::rig::read_rig_file(out), cam).camera.fx;
+  };
+  const double fx_right_equi = fx("right");
+  r = run(args + "pinhole-radtan");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const double fx_left_radtan = fx("left");
+  r = run(args + "left=pinhole-radtan,right=pinhole-equi");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const rigcal::rig::Rig mixed = rigcal::rig::read_rig_file(out);
+  EXPECT_EQ(rigcal::rig::sensor(mixed, "left").camera.distortion_model,
+            rigcal::rig::DistortionModel::radtan);
+  EXPECT_EQ(rigcal::rig::sensor(mixed, "right").camera.distortion_model,
+            rigcal::rig::DistortionModel::equidistant);
+  const nlohmann::json j = nlohmann::json::parse(slurp(fs::path(report) / "cameras.json"));
+  EXPECT_EQ(j["cameras"][0]["model"]["distortion_model"], "radtan");
+  EXPECT_EQ(j["cameras"][1]["model"]["distortion_model"], "equidistant");
+  EXPECT_EQ(j["cameras"][1]["stddev"]["distortion_coeffs"].size(), 4u);
+  const double sigma_left = j["cameras"][0]["stddev"]["intrinsics"][0].get<double>();
+  const double sigma_right = j["cameras"][1]["stddev"]["intrinsics"][0].get<double>();
+  std::printf(
+      "fx: left %.3f (radtan for both %.3f, 1-sigma %.3f), right %.3f (equidistant for "
+      "both %.3f, 1-sigma %.3f)\n",
+      fx("left"), fx_left_radtan, sigma_left, fx("right"), fx_right_equi, sigma_right);
+  EXPECT_NEAR(fx("left"), fx_left_radtan, sigma_left);
+  EXPECT_NEAR(fx("right"), fx_right_equi, sigma_right);
   struct Refusal {
     const char *model, *says;
   };
   for (const Refusal& bad :
-       {Refusal{"left=pinhole-radtan,right=pinhole-equi", "different models per camera"},
-        Refusal{"omni-radtan", "Kalibr's omni-radtan has no counterpart in rigcal"},
+       {Refusal{"omni-radtan", "Kalibr's omni-radtan has no counterpart in rigcal"},
         Refusal{"left=pinhole-radtan", "no model for camera 'right'"},
         Refusal{"left=pinhole-radtan,middle=pinhole-radtan", "no camera 'middle'"},
         Refusal{"pinhole-fisheye", "expected pinhole-radtan, pinhole-radtan5 or"}}) {
