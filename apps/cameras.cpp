@@ -74,6 +74,7 @@ void add_cameras(CLI::App& app) {
       "with --session. Writes the rig (OUT.yaml) and a report folder: cameras.json (every figure\n"
       "with its definition), corners.vnl (detections, mrcal's format, reused on the next run),\n"
       "PNGs per camera: corners, residual vectors x100, coverage, projection uncertainty,\n"
+      "NAME.cameramodel per camera with mrcal's optimization_inputs (mrcal's tools run on it),\n"
       "the stereo pair rectified; and report.html, the page to read (doc/report.md).");
   cmd->add_option("--target", o->target, "target YAML (targets/*.yaml; Kalibr's format)")
       ->required();

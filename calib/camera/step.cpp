@@ -18,6 +18,7 @@
 #include "rigcal/core/stats.h"
 #include "rigcal/core/text.h"
 #include "rigcal/io/files.h"
+#include "rigcal/io/mrcal_cameramodel.h"
 #include "rigcal/io/target_yaml.h"
 #include "rigcal/report/json.h"
 #include "rigcal/report/rotation.h"
@@ -400,6 +401,13 @@ report::StepResult calibrate_cameras(const StepInputs& in, const StepOptions& o,
   for (const std::string& line : summary_lines(names, r, rep)) out.summary.push_back(line);
   out.notes = r.notes;
   for (const std::string& n : in.images.notes) out.notes.push_back(n);
+  // mrcal's tools on this result: <camera>.cameramodel with the solve's optimization_inputs.
+  if (const std::string why = io::mrcal_unsupported(r, target, names); why.empty()) {
+    for (io::OutputFile& f : io::mrcal_cameramodels(r, target, names))
+      out.report_files.push_back(std::move(f));
+  } else {
+    out.notes.push_back("no <camera>.cameramodel for mrcal's tools in the report: " + why);
+  }
   out.residuals = {{"rms_2d_px", r.rms_2d_px, "px"},
                    {"rms_coord_px", r.rms_coord_px, "px"},
                    {"outlier_corners", static_cast<double>(r.n_outliers), ""},
