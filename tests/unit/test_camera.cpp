@@ -4,12 +4,15 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "camera_bound.h"
 #include "camera_truth.h"
 #include "fixtures.h"
 #include "rigcal/camera/calibrate.h"
@@ -288,6 +291,131 @@ std::vector<double> projection_z(const CalibrationResult& r, const sim::StereoPa
   return z;
 }
 
+// The reported uncertainty against the Cramér–Rao bound computed here (camera_bound.h: OpenCV's
+// projection, central differences, the true parameters, the corner noise measured against
+// truth), and the errors against both. Fills `out`'s figures; with `strict`, asserts:
+// - the bound well-posed (condition of the scaled normal matrix below 1e8; measured 2.1e6-4.1e6
+//   on the A3 board over 20 seeds and both models, 7.2e5 with the AprilGrid);
+// - the reported 1-sigma of every parameter within [kSigmaOverBoundMin, kSigmaOverBoundMax]
+//   times the bound's (camera_truth.h);
+// - the solver's error equal to the bound's first-order least-squares error for the same corners
+//   within 0.1 reported sigma (measured: within 0.01): the solver reaches the optimum, so that
+//   what remains between its errors and the bound is the corners' noise, not the solver;
+// - per group, the errors' squared Mahalanobis distance under the reported covariance of the group
+//   below chi-square's 0.999 quantile with n = the group's size degrees of freedom. For an
+//   efficient estimator whose covariance is the reported one, that distance is chi-square(n)
+//   distributed, so one seed fails by chance once in a thousand per group. The full covariance
+//   block and not the pooled error / sigma: the parameters of a group are correlated (the largest
+//   |rho| is printed), and the sum of squared correlated z's is not chi-square(n) (its tail is
+//   heavier: with rho = 1 its 0.999 quantile is n * 10.8, against 18.5 for n = 4).
+void compare_with_the_bound(const CalibrationResult& r, const rig::Rig& rig,
+                            const sim::StereoPart& part, const Target& target, const SE3& T_true,
+                            const Eigen::Vector3d& rot_err_deg, uint64_t seed, bool print,
+                            bool strict, TruthZ& out) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::vector<rig::CameraModel> truth = {rig::sensor(rig, "cam_l").camera,
+                                               rig::sensor(rig, "cam_r").camera};
+  const CramerRaoBound bound = cramer_rao_bound(truth, {SE3(), T_true}, part.T_left_board,
+                                                object_points(target), r.residuals);
+  // The reported values in the bound's layout: intrinsics, then the rotation (deg; the solver's
+  // covariance is in Ceres' quaternion tangent, half the angle) and the translation, taken from
+  // the solver's covariance at its per-camera indices.
+  const int NK = static_cast<int>(r.cameras[0].stddev.size());
+  const int K = 2 * NK + 6;
+  ASSERT_EQ(bound.sigma.size(), K);
+  Eigen::VectorXd error(K), unit = Eigen::VectorXd::Ones(K);
+  std::vector<std::string> group(K);
+  std::vector<int> at(K);  // where each parameter is in the solver's covariance
+  for (int c = 0; c < 2; ++c) {
+    const std::vector<double> k_true = intrinsics_vector(truth[c]),
+                              k_est = intrinsics_vector(r.cameras[c].model);
+    ASSERT_EQ(static_cast<int>(k_est.size()), NK);
+    for (int i = 0; i < NK; ++i) {
+      error[c * NK + i] = k_est[i] - k_true[i];
+      group[c * NK + i] = kParameterGroups[i < 2 ? 0 : i < 4 ? 1 : 2];
+      at[c * NK + i] = r.intrinsics_covariance_index[c] + i;
+    }
+  }
+  for (int i = 0; i < 3; ++i) {
+    error[2 * NK + i] = rot_err_deg[i];
+    error[2 * NK + 3 + i] = r.T_cam_cam0[1].t[i] - T_true.t[i];
+    unit[2 * NK + i] = 360.0 / M_PI;
+    group[2 * NK + i] = kParameterGroups[3];
+    group[2 * NK + 3 + i] = kParameterGroups[4];
+    at[2 * NK + i] = r.pose_covariance_index[1] + i;
+    at[2 * NK + 3 + i] = r.pose_covariance_index[1] + 3 + i;
+  }
+  Eigen::MatrixXd reported(K, K);
+  for (int i = 0; i < K; ++i)
+    for (int j = 0; j < K; ++j) reported(i, j) = unit[i] * r.covariance(at[i], at[j]) * unit[j];
+  out.noise_truth_px = bound.noise_sigma_px;
+  out.noise_reported_px = r.noise_sigma_px;
+  out.bound_condition = bound.condition;
+  out.view_mean_z_rms = bound.view_mean_z_rms;
+  out.neighbour_correlation = bound.neighbour_correlation;
+  out.figures.clear();
+  for (int k = 0; k < K; ++k) {
+    out.figures.push_back({bound.names[k], group[k], error[k], std::sqrt(reported(k, k)),
+                           bound.sigma[k], bound.lsq_error[k]});
+  }
+  out.groups.clear();
+  std::map<std::string, double> max_rho;  // the largest |correlation| in a group, printed
+  for (const char* g : kParameterGroups) {
+    std::vector<int> idx;
+    for (int k = 0; k < K; ++k)
+      if (group[k] == g) idx.push_back(k);
+    const int n = static_cast<int>(idx.size());
+    Eigen::VectorXd e(n);
+    Eigen::MatrixXd C(n, n), B(n, n);
+    for (int i = 0; i < n; ++i) {
+      e[i] = error[idx[i]];
+      for (int j = 0; j < n; ++j) {
+        C(i, j) = reported(idx[i], idx[j]);
+        B(i, j) = bound.covariance(idx[i], idx[j]);
+      }
+    }
+    out.groups.push_back({g, n, e.dot(C.ldlt().solve(e)), e.dot(B.ldlt().solve(e))});
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < i; ++j)
+        max_rho[g] = std::max(max_rho[g], std::abs(C(i, j)) / std::sqrt(C(i, i) * C(j, j)));
+  }
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  if (print) {
+    std::printf(
+        "seed %lu, the bound (%zu inlier corners, %zu frames, %zu parameters, condition %.2e, "
+        "%.0f ms): corner noise against truth %.4f px per coordinate (mean %+.4f %+.4f), the "
+        "solver's from the residuals %.4f px; independent corners? per-view mean error %.2f "
+        "sigma rms (1 if so), neighbours' correlation %+.3f (0)\n",
+        seed, bound.n_corners, bound.n_frames, bound.n_parameters, bound.condition, ms,
+        bound.noise_sigma_px, bound.noise_mean_px.x(), bound.noise_mean_px.y(), r.noise_sigma_px,
+        bound.view_mean_z_rms, bound.neighbour_correlation);
+    std::printf("  %-26s %11s %11s %11s %7s %7s %11s\n", "parameter", "error", "reported", "bound",
+                "rep/bnd", "err/rep", "lsq error");
+    for (const TruthZ::Parameter& p : out.figures) {
+      std::printf("  %-26s %+11.3e %11.3e %11.3e %7.3f %+7.2f %+11.3e\n", p.name.c_str(), p.error,
+                  p.sigma, p.bound, p.sigma / p.bound, p.error / p.sigma, p.lsq_error);
+    }
+    for (const TruthZ::Group& g : out.groups) {
+      std::printf(
+          "  %-18s squared Mahalanobis distance %6.2f under the reported covariance (%d dof: "
+          "P(chi2 >= it) = %.3f), %6.2f under the bound's; largest |correlation| %.2f\n",
+          g.group.c_str(), g.mahalanobis2, g.n, chi2_upper_tail(g.mahalanobis2, g.n),
+          g.mahalanobis2_bound, max_rho[g.group]);
+    }
+  }
+  if (!strict) return;
+  // A well-posed bound: the normal matrix (columns scaled) far from singular.
+  EXPECT_LT(bound.condition, 1e8);
+  for (const TruthZ::Parameter& p : out.figures) {
+    EXPECT_LE(p.sigma, kSigmaOverBoundMax * p.bound) << p.name;
+    EXPECT_GE(p.sigma, kSigmaOverBoundMin * p.bound) << p.name;
+    EXPECT_LE(std::abs(p.error - p.lsq_error), 0.1 * p.sigma) << p.name;
+  }
+  for (const TruthZ::Group& g : out.groups)
+    EXPECT_GE(chi2_upper_tail(g.mahalanobis2, g.n), 0.001) << g.group << ": " << g.mahalanobis2;
+}
+
 // Simulated truth: the default 40 views of the A3 board at the default noise, 1388 x 700.
 // Returns, per checked quantity, the error in units of the reported 1-sigma.
 TruthZ check_against_truth(const SimCase& sc, uint64_t seed, bool print, bool strict = true) {
@@ -368,6 +496,7 @@ TruthZ check_against_truth(const SimCase& sc, uint64_t seed, bool print, bool st
       z.push_back(std::abs(k_est[i] - k_true[i]) / r.cameras[c].stddev[i]);
   }
   for (int i = 0; i < 3; ++i) z.push_back(std::abs(rot_err[i]) / r.rotation_stddev_deg[1][i]);
+  compare_with_the_bound(r, rig, part, cfg.target, T_true, rot_err, seed, print, strict, out);
   // Projection uncertainty as mrcal defines it, at the median board distance.
   std::vector<double> distances;
   for (const auto& T : r.T_cam0_board) {
