@@ -5,7 +5,9 @@
 #include <string>
 #include <vector>
 
+#include "rigcal/camera/calibrate.h"
 #include "rigcal/rig/rig.h"
+#include "rigcal/sim/session.h"
 
 namespace rigcal::camera {
 
@@ -61,5 +63,8 @@ inline const char* const kParameterGroups[] = {"focal", "principal point", "dist
 TruthZ check_against_truth_for_long_test(rig::DistortionModel model, uint64_t seed);
 // The same with the 6 x 6 AprilGrid (88 mm tags), radtan.
 TruthZ check_aprilgrid_for_long_test(uint64_t seed);
+
+// The simulated stereo part's images through rigcal's detector: cam_l and cam_r, 1388 x 700.
+std::vector<CameraInput> detect_stereo(const sim::StereoPart& part, const Target& target);
 
 }  // namespace rigcal::camera

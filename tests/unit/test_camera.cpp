@@ -428,14 +428,7 @@ TruthZ check_against_truth(const SimCase& sc, uint64_t seed, bool print, bool st
   cfg.seed = seed;
   if (!sc.target_file.empty()) cfg.target = io::read_target_file(sc.target_file);
   const sim::StereoPart part = sim::simulate_stereo(rig, cfg);
-  std::vector<CameraInput> cams(2);
-  cams[0].name = "cam_l";
-  cams[1].name = "cam_r";
-  for (size_t k = 0; k < part.left.size(); ++k) {
-    cams[0].frames.push_back(detect(part.left[k], cfg.target));
-    cams[1].frames.push_back(detect(part.right[k], cfg.target));
-  }
-  for (CameraInput& c : cams) c.width = 1388, c.height = 700;
+  const std::vector<CameraInput> cams = detect_stereo(part, cfg.target);
   CalibrationOptions opt;
   opt.model = sc.model;
   const CalibrationResult r = calibrate(cfg.target, cams, opt);
@@ -532,6 +525,18 @@ const SimCase kEquidistant{rig::DistortionModel::equidistant,
                            ""};
 
 }  // namespace
+
+std::vector<CameraInput> detect_stereo(const sim::StereoPart& part, const Target& target) {
+  std::vector<CameraInput> cams(2);
+  cams[0].name = "cam_l";
+  cams[1].name = "cam_r";
+  for (size_t k = 0; k < part.left.size(); ++k) {
+    cams[0].frames.push_back(detect(part.left[k], target));
+    cams[1].frames.push_back(detect(part.right[k], target));
+  }
+  for (CameraInput& c : cams) c.width = 1388, c.height = 700;
+  return cams;
+}
 
 // For tests/long: the same check for any seed.
 TruthZ check_against_truth_for_long_test(rig::DistortionModel model, uint64_t seed) {

@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "camera_truth.h"
 #include "camera_warp.h"
 #include "rigcal/camera/calibrate.h"
 #include "rigcal/camera/detect.h"
@@ -24,14 +25,7 @@ WarpRun warp_run(const Eigen::Vector2d& truth_m, uint64_t seed) {
   cfg.seed = seed;
   cfg.board_warp_m = truth_m;
   const sim::StereoPart part = sim::simulate_stereo(rig, cfg);
-  std::vector<CameraInput> cams(2);
-  cams[0].name = "cam_l";
-  cams[1].name = "cam_r";
-  for (size_t k = 0; k < part.left.size(); ++k) {
-    cams[0].frames.push_back(detect(part.left[k], cfg.target));
-    cams[1].frames.push_back(detect(part.right[k], cfg.target));
-  }
-  for (CameraInput& c : cams) c.width = 1388, c.height = 700;
+  const std::vector<CameraInput> cams = detect_stereo(part, cfg.target);
   const SE3 T_r_l_true = rig::T_a_b(rig, "cam_r", "cam_l");
   WarpRun out;
   for (const bool solve_warp : {false, true}) {
