@@ -27,12 +27,6 @@ std::string lensmodel_of(const rig::CameraModel& m) {
   return "";
 }
 
-std::vector<double> intrinsics_of(const rig::CameraModel& m) {
-  std::vector<double> k = {m.fx, m.fy, m.cx, m.cy};
-  k.insert(k.end(), m.distortion_coeffs.begin(), m.distortion_coeffs.end());
-  return k;
-}
-
 // mrcal's rt of T_a_b: the Rodrigues vector of R_a_b, then t_a_b.
 void append_rt(std::vector<double>& out, const SE3& T_a_b) {
   const Eigen::Vector3d r = rotation_vector(T_a_b.R);
@@ -181,7 +175,7 @@ std::vector<NamedArray> mrcal_optimization_inputs(const camera::CalibrationResul
   std::vector<int32_t> imagersizes;
   for (size_t c = 0; c < n_cams; ++c) {
     const rig::CameraModel& m = r.cameras[c].model;
-    const std::vector<double> k = intrinsics_of(m);
+    const std::vector<double> k = camera::intrinsics_vector(m);
     intrinsics.insert(intrinsics.end(), k.begin(), k.end());
     imagersizes.insert(imagersizes.end(), {m.width, m.height});
     if (c > 0) append_rt(extrinsics_rt, r.T_cam_cam0[c]);
@@ -238,29 +232,32 @@ std::vector<OutputFile> mrcal_cameramodels(const camera::CalibrationResult& r,
         "    'imagersize': [{}, {}],\n"
         "    'extrinsics': {},\n"
         "    'icam_intrinsics': {},\n",
-        names[c], version_string(), names[0], index, lensmodel, number_list(intrinsics_of(m)),
-        m.width, m.height, number_list(rt), c);
+        names[c], version_string(), names[0], index, lensmodel,
+        number_list(camera::intrinsics_vector(m)), m.width, m.height, number_list(rt), c);
     // The blob on one line: libmrcal's parser does not join adjacent literals.
     text += "    'optimization_inputs': b'" + blob + "',\n}\n";
 
     // Self-check with libmrcal's own reader (which skips optimization_inputs).
     if (text.size() > static_cast<size_t>(std::numeric_limits<int>::max()))
       throw Error(fmt::format("{}: the .cameramodel text would be over 2 GiB", names[c]));
-    mrcal_cameramodel_t* model =
-        mrcal_read_cameramodel_string(text.c_str(), static_cast<int>(text.size()));
-    if (model == nullptr) {
-      throw Error(
-          fmt::format("{}: libmrcal did not accept the generated .cameramodel text", names[c]));
-    }
-    const std::string read_lensmodel = mrcal_lensmodel_name_unconfigured(&model->lensmodel);
-    mrcal_free_cameramodel(&model);
-    if (read_lensmodel != lensmodel) {
-      throw Error(fmt::format("{}: libmrcal read lens model {} instead of {}", names[c],
-                              read_lensmodel, lensmodel));
-    }
+    check_with_libmrcal(text, lensmodel, names[c]);
     files.push_back({names[c] + ".cameramodel", std::move(text)});
   }
   return files;
+}
+
+void check_with_libmrcal(const std::string& text, const std::string& lensmodel,
+                         const std::string& name) {
+  mrcal_cameramodel_t* model =
+      mrcal_read_cameramodel_string(text.c_str(), static_cast<int>(text.size()));
+  if (model == nullptr)
+    throw Error(fmt::format("{}: libmrcal did not accept the generated .cameramodel text", name));
+  const std::string read_lensmodel = mrcal_lensmodel_name_unconfigured(&model->lensmodel);
+  mrcal_free_cameramodel(&model);
+  if (read_lensmodel != lensmodel) {
+    throw Error(fmt::format("{}: libmrcal read lens model {} instead of {}", name, read_lensmodel,
+                            lensmodel));
+  }
 }
 
 }  // namespace rigcal::io

@@ -62,4 +62,9 @@ std::vector<OutputFile> mrcal_cameramodels(const camera::CalibrationResult& resu
                                            const std::vector<std::string>& names,
                                            ZipMethod method = ZipMethod::deflated);
 
+// Reads `text` back with libmrcal's own reader: throws rigcal::Error naming the camera when it
+// does not load or loads with another lens model than `lensmodel`.
+void check_with_libmrcal(const std::string& text, const std::string& lensmodel,
+                         const std::string& name);
+
 }  // namespace rigcal::io

@@ -11,6 +11,7 @@
 #include "rigcal/core/error.h"
 #include "rigcal/core/text.h"
 #include "rigcal/core/version.h"
+#include "rigcal/io/mrcal_cameramodel.h"
 #include "rigcal/rig/rig_yaml.h"
 
 extern "C" {
@@ -314,17 +315,7 @@ std::string mrcal_cameramodel(const Rig& rig, std::string_view name) {
       yaml_list(rt));
 
   // Self-check with libmrcal's own reader: the file must load, with our lens model.
-  mrcal_cameramodel_t* model =
-      mrcal_read_cameramodel_string(text.c_str(), static_cast<int>(text.size()));
-  if (model == nullptr) {
-    throw Error(fmt::format("{}: libmrcal did not accept the generated .cameramodel text", s.name));
-  }
-  const std::string read_lensmodel = mrcal_lensmodel_name_unconfigured(&model->lensmodel);
-  mrcal_free_cameramodel(&model);
-  if (read_lensmodel != lensmodel) {
-    throw Error(fmt::format("{}: libmrcal read lens model {} instead of {}", s.name, read_lensmodel,
-                            lensmodel));
-  }
+  io::check_with_libmrcal(text, lensmodel, s.name);
   return text;
 }
 
