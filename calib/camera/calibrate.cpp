@@ -548,12 +548,6 @@ void add_camera_pose(CalibrationResult& res, size_t c, const std::vector<Pose>& 
 
 }  // namespace
 
-std::vector<double> intrinsics_vector(const rig::CameraModel& m) {
-  std::vector<double> k = {m.fx, m.fy, m.cx, m.cy};
-  k.insert(k.end(), m.distortion_coeffs.begin(), m.distortion_coeffs.end());
-  return k;
-}
-
 CalibrationResult calibrate(const Target& target, const std::vector<CameraInput>& cams,
                             const CalibrationOptions& opt) {
   check_frames_pair_up(cams);

@@ -99,7 +99,4 @@ struct CalibrationResult {
 CalibrationResult calibrate(const Target& target, const std::vector<CameraInput>& cameras,
                             const CalibrationOptions& options = {});
 
-// The intrinsics vector [fx fy cx cy k...] of a model.
-std::vector<double> intrinsics_vector(const rig::CameraModel& model);
-
 }  // namespace rigcal::camera

@@ -5,6 +5,12 @@
 
 namespace rigcal::camera {
 
+std::vector<double> intrinsics_vector(const rig::CameraModel& c) {
+  std::vector<double> k = {c.fx, c.fy, c.cx, c.cy};
+  k.insert(k.end(), c.distortion_coeffs.begin(), c.distortion_coeffs.end());
+  return k;
+}
+
 Eigen::Vector2d distort(const rig::CameraModel& c, const Eigen::Vector2d& xn) {
   const std::vector<double>& k = c.distortion_coeffs;
   const double x = xn.x(), y = xn.y();

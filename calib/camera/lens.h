@@ -4,6 +4,7 @@
 //   equidistant  θ = atan(r), θd = θ (1 + k1 θ² + k2 θ⁴ + k3 θ⁶ + k4 θ⁸), x' = (θd / r) x
 // then u = fx x' + cx, v = fy y' + cy, pixel (0, 0) the centre of the top-left pixel.
 #include <optional>
+#include <vector>
 
 #include "rigcal/rig/rig.h"
 
@@ -18,5 +19,7 @@ std::optional<Eigen::Vector2d> project(const rig::CameraModel& camera,
                                        const Eigen::Vector3d& p_cam);
 // Normalized pinhole coordinates of a pixel (the ray through it is (x, y, 1)).
 Eigen::Vector2d unproject(const rig::CameraModel& camera, const Eigen::Vector2d& pixel);
+// The intrinsics vector [fx fy cx cy k...] of a model, in the order of its distortion model.
+std::vector<double> intrinsics_vector(const rig::CameraModel& camera);
 
 }  // namespace rigcal::camera

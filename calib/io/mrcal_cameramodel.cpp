@@ -7,6 +7,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "rigcal/camera/lens.h"
 #include "rigcal/core/error.h"
 #include "rigcal/core/se3.h"
 #include "rigcal/core/text.h"
