@@ -1,8 +1,11 @@
 #include "rigcal/camera/detect.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
+#include <array>
+#include <map>
 #include <opencv2/aruco.hpp>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -106,8 +109,172 @@ Detection detect_checkerboard(const cv::Mat& gray, const Target& t, const Detect
   return d;
 }
 
-Detection detect_aprilgrid(const cv::Mat& gray, const Target& t, const DetectOptions& o) {
-  Detection d;
+// The Kalibr point ids of tag `id`'s corners in aruco's order (the printed tag's top left, top
+// right, bottom right, bottom left): (2c, 2r + 1), (2c + 1, 2r + 1), (2c + 1, 2r), (2c, 2r).
+std::array<int, 4> tag_point_ids(const Target& t, int id) {
+  const int c = id % t.cols, r = id / t.cols, w = 2 * t.cols;
+  return {(2 * r + 1) * w + 2 * c, (2 * r + 1) * w + 2 * c + 1, 2 * r * w + 2 * c + 1,
+          2 * r * w + 2 * c};
+}
+
+using TagCorners = std::array<cv::Point2f, 4>;
+
+// Bilinear intensity at a sub-pixel position inside the image.
+double bilinear(const cv::Mat& gray, double x, double y) {
+  const int u = static_cast<int>(std::floor(x)), v = static_cast<int>(std::floor(y));
+  const double a = x - u, b = y - v;
+  const uint8_t* r0 = gray.ptr<uint8_t>(v);
+  const uint8_t* r1 = gray.ptr<uint8_t>(v + 1);
+  return (1 - b) * ((1 - a) * r0[u] + a * r0[u + 1]) + b * ((1 - a) * r1[u] + a * r1[u + 1]);
+}
+
+// Whether the image shows tag `id` as printed through these corners: the tag's 10 x 10 cells
+// (its 2-bit border and 6 x 6 data bits) and the ring of cells around it (the white gap, the
+// corner squares), 144 cells, each read as the mean of four samples about its centre through the
+// homography of the four corners, split into black and white at the midpoint of the means of
+// the cells printed black and of those printed white. At most `max_misread` cells may read
+// otherwise: tag36h11's codes differ in at least 11 of the 36 bits, so another tag, a tag put
+// one place off, or anything else that is not this tag, fails. Ring cells off the printed
+// board (a grid without margin) are not read.
+bool reads_as_printed(const cv::Mat& gray, const Target& t, const Pattern& pattern,
+                      const std::vector<Eigen::Vector3d>& object, int id, const TagCorners& px,
+                      int max_misread) {
+  const std::array<int, 4> ids = tag_point_ids(t, id);
+  std::vector<cv::Point2f> board(4), image(px.begin(), px.end());
+  for (int k = 0; k < 4; ++k)
+    board[k] =
+        cv::Point2f(static_cast<float>(object[ids[k]].x()), static_cast<float>(object[ids[k]].y()));
+  const cv::Matx33d H = cv::getPerspectiveTransform(board, image);
+  const Outline o = outline(t);
+  const double x0 = object[ids[3]].x(), y0 = object[ids[3]].y(), cell = t.tag_size / 10.0;
+  std::vector<std::pair<double, bool>> cells;  // (intensity, printed white)
+  for (int j = -1; j <= 10; ++j) {
+    for (int i = -1; i <= 10; ++i) {
+      const double bx = x0 + (i + 0.5) * cell, by = y0 + (j + 0.5) * cell;
+      if (bx < o.x_min || bx > o.x_max || by < o.y_min || by > o.y_max) continue;
+      double sum = 0.0;
+      for (int q = 0; q < 4; ++q) {
+        const double sx = bx + (q % 2 ? 0.2 : -0.2) * cell, sy = by + (q / 2 ? 0.2 : -0.2) * cell;
+        const cv::Vec3d h = H * cv::Vec3d(sx, sy, 1.0);
+        const double u = h[0] / h[2], v = h[1] / h[2];
+        if (!(u >= 0 && v >= 0 && u < gray.cols - 1 && v < gray.rows - 1)) return false;
+        sum += bilinear(gray, u, v);
+      }
+      cells.emplace_back(0.25 * sum, pattern.albedo(bx, by) > 0.5);
+    }
+  }
+  double white = 0.0, black = 0.0;
+  int n_white = 0, n_black = 0;
+  for (const auto& [value, is_white] : cells) {
+    (is_white ? white : black) += value;
+    (is_white ? n_white : n_black) += 1;
+  }
+  if (n_white == 0 || n_black == 0) return false;
+  white /= n_white;
+  black /= n_black;
+  if (white - black < 10.0) return false;  // no contrast: nothing can be read
+  const double mid = 0.5 * (white + black);
+  int misread = 0;
+  for (const auto& [value, is_white] : cells) misread += (value > mid) != is_white;
+  return misread <= max_misread;
+}
+
+void refine_corners(const cv::Mat& gray, std::vector<cv::Point2f>& corners, double tag_px) {
+  const int w = std::clamp(static_cast<int>(0.12 * tag_px), 2, 11);
+  cv::cornerSubPix(gray, corners, cv::Size(w, w), cv::Size(-1, -1),
+                   cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-4));
+}
+
+// The shortest side: the window of a foreshortened tag's corners must stay inside its border
+// across the tag's short direction too.
+double shortest_side_px(const TagCorners& px) {
+  double s = INFINITY;
+  for (int k = 0; k < 4; ++k)
+    s = std::min(s, static_cast<double>(cv::norm(px[k] - px[(k + 1) % 4])));
+  return s;
+}
+
+double side_px(const TagCorners& px) {
+  return 0.25 * (cv::norm(px[0] - px[1]) + cv::norm(px[1] - px[2]) + cv::norm(px[2] - px[3]) +
+                 cv::norm(px[3] - px[0]));
+}
+
+// Tags aruco did not decode, found from the grid: each missing tag's corners predicted by the
+// homography of the decoded tags nearest to it on the board (up to four, at most 2.9 tag pitches
+// away: local, so that lens distortion stays small across them), refined as saddle points like
+// the decoded tags' corners, and kept only if the image reads as that tag through them
+// (reads_as_printed). Repeated while tags are added, so that the grid grows from what aruco read
+// into the tags next to it.
+int complete_grid(const cv::Mat& gray, const Target& t, const Pattern& pattern,
+                  const std::vector<Eigen::Vector3d>& object, std::map<int, TagCorners>& tags) {
+  const double pitch = t.tag_size * (1.0 + t.tag_spacing);
+  auto centre = [&](int id) {
+    return Eigen::Vector2d((id % t.cols) * pitch, (id / t.cols) * pitch);
+  };
+  int added = 0;
+  for (bool grew = true; grew;) {
+    grew = false;
+    for (int id = 0; id < t.cols * t.rows; ++id) {
+      if (tags.count(id)) continue;
+      std::vector<std::pair<double, int>> near;
+      for (const auto& [other, px] : tags) {
+        const double d = (centre(other) - centre(id)).norm() / pitch;
+        if (d <= 2.9) near.emplace_back(d, other);
+      }
+      // Two tags or more, or one next to this one (its four corners fix the homography
+      // exactly; extrapolated one tag over, the error stays a fraction of a cell).
+      if (near.empty() || (near.size() < 2 && near[0].first > 1.5)) continue;
+      std::sort(near.begin(), near.end());
+      near.resize(std::min<size_t>(near.size(), 4));
+      std::vector<cv::Point2f> board, image;
+      for (const auto& [d, other] : near) {
+        const std::array<int, 4> ids = tag_point_ids(t, other);
+        for (int k = 0; k < 4; ++k) {
+          board.emplace_back(object[ids[k]].x(), object[ids[k]].y());
+          image.push_back(tags[other][k]);
+        }
+      }
+      const cv::Mat H = cv::findHomography(board, image, 0);
+      if (H.empty()) continue;
+      const std::array<int, 4> ids = tag_point_ids(t, id);
+      std::vector<cv::Point2f> corner_board, predicted;
+      for (int k = 0; k < 4; ++k) corner_board.emplace_back(object[ids[k]].x(), object[ids[k]].y());
+      cv::perspectiveTransform(corner_board, predicted, H);
+      TagCorners px;
+      std::copy(predicted.begin(), predicted.end(), px.begin());
+      const double side = side_px(px);
+      const double margin = 0.12 * side + 2.0;
+      bool inside = side >= 10.0;  // below: too few pixels a bit to read
+      for (const cv::Point2f& p : predicted)
+        inside = inside && p.x >= margin && p.y >= margin && p.x < gray.cols - margin &&
+                 p.y < gray.rows - margin;
+      if (!inside) continue;
+      std::vector<cv::Point2f> refined = predicted;
+      refine_corners(gray, refined, shortest_side_px(px));
+      bool near_prediction = true;
+      for (int k = 0; k < 4; ++k)
+        near_prediction = near_prediction && cv::norm(refined[k] - predicted[k]) < 0.2 * side;
+      if (!near_prediction) continue;
+      std::copy(refined.begin(), refined.end(), px.begin());
+      if (!reads_as_printed(gray, t, pattern, object, id, px, 3)) continue;
+      tags[id] = px;
+      ++added;
+      grew = true;
+    }
+  }
+  return added;
+}
+
+// One pass of OpenCV's aruco over an image `scale` times the size of the one detected in: the
+// grid's tags it decoded, and the quads it found but could not read, in the detected image's
+// pixels.
+struct ArucoPass {
+  std::map<int, TagCorners> tags;
+  std::vector<TagCorners> unread;
+  int wrong = 0;  // ids outside the grid
+};
+
+ArucoPass aruco_pass(const cv::Mat& image, const Target& t, double scale) {
   static const cv::Ptr<cv::aruco::Dictionary> dict =
       cv::aruco::getPredefinedDictionary(cv::aruco::DICT_APRILTAG_36h11);
   cv::Ptr<cv::aruco::DetectorParameters> params = cv::aruco::DetectorParameters::create();
@@ -120,45 +287,105 @@ Detection detect_aprilgrid(const cv::Mat& gray, const Target& t, const DetectOpt
   params->perspectiveRemovePixelPerCell = 8;
   params->perspectiveRemoveIgnoredMarginPerCell = 0.25;
   std::vector<int> ids;
-  std::vector<std::vector<cv::Point2f>> tags;
-  cv::aruco::detectMarkers(gray, dict, tags, ids, params);
-  const int n_tags = t.cols * t.rows;
-  std::vector<cv::Point2f> corners;
-  std::vector<double> sizes;
-  int wrong = 0;
+  std::vector<std::vector<cv::Point2f>> found, rejected;
+  cv::aruco::detectMarkers(image, dict, found, ids, params, rejected);
+  ArucoPass pass;
+  auto corners = [&](const std::vector<cv::Point2f>& quad) {
+    TagCorners px;
+    for (int k = 0; k < 4; ++k) px[k] = quad[k] * static_cast<float>(1.0 / scale);
+    return px;
+  };
   for (size_t i = 0; i < ids.size(); ++i) {
-    if (ids[i] < 0 || ids[i] >= n_tags) {
-      ++wrong;
-      continue;
-    }
-    const int c = ids[i] % t.cols, r = ids[i] / t.cols;
-    // aruco: top-left, top-right, bottom-right, bottom-left of the printed tag; Kalibr points:
-    // (2c, 2r + 1), (2c + 1, 2r + 1), (2c + 1, 2r), (2c, 2r).
-    const int m[4] = {2 * c, 2 * c + 1, 2 * c + 1, 2 * c};
-    const int nn[4] = {2 * r + 1, 2 * r + 1, 2 * r, 2 * r};
-    for (int k = 0; k < 4; ++k) {
-      d.point_ids.push_back(nn[k] * 2 * t.cols + m[k]);
-      corners.push_back(tags[i][k]);
-    }
-    sizes.push_back(0.25 * cv::arcLength(tags[i], true));
+    if (ids[i] < 0 || ids[i] >= t.cols * t.rows)
+      ++pass.wrong;
+    else if (!pass.tags.count(ids[i]))  // aruco reports some tags twice; the first is kept
+      pass.tags[ids[i]] = corners(found[i]);
   }
-  if (static_cast<int>(sizes.size()) < o.min_tags) {
-    d.point_ids.clear();
-    d.note = fmt::format("{} tags of the grid decoded (fewer than {})", sizes.size(), o.min_tags);
-    return d;
+  for (const std::vector<cv::Point2f>& quad : rejected) pass.unread.push_back(corners(quad));
+  return pass;
+}
+
+// Quads aruco found but could not decode, read as the grid's tags: corners refined, then each
+// tag not yet found tried in each of the four turns with reads_as_printed (the grid has few
+// tags, and which cells are black is known: a reading aruco's general decoder cannot make on
+// blurred or small tags).
+int read_quads(const cv::Mat& gray, const Target& t, const Pattern& pattern,
+               const std::vector<Eigen::Vector3d>& object, const std::vector<TagCorners>& quads,
+               std::map<int, TagCorners>& tags) {
+  int added = 0;
+  for (const TagCorners& quad : quads) {
+    const double side = side_px(quad);
+    if (side < 10.0) continue;
+    std::vector<cv::Point2f> refined(quad.begin(), quad.end());
+    refine_corners(gray, refined, shortest_side_px(quad));
+    bool read = false;
+    for (int id = 0; id < t.cols * t.rows && !read; ++id) {
+      if (tags.count(id)) continue;
+      for (int turn = 0; turn < 4 && !read; ++turn) {
+        TagCorners px;
+        for (int k = 0; k < 4; ++k) px[k] = refined[(k + turn) % 4];
+        if (!reads_as_printed(gray, t, pattern, object, id, px, 3)) continue;
+        tags[id] = px;
+        read = true;
+        ++added;
+      }
+    }
   }
+  return added;
+}
+
+Detection detect_aprilgrid(const cv::Mat& gray, const Target& t, const DetectOptions& o) {
+  const Pattern pattern(t);
+  const std::vector<Eigen::Vector3d> object = object_points(t);
+  const int n_tags = t.cols * t.rows;
+  std::map<int, TagCorners> tags;
+  int wrong = 0, aruco = 0, quads = 0, completed = 0;
   // Tag corners meet the grid's corner squares: saddle points cornerSubPix refines. The window
   // (0.12 of the tag side) stays inside the tag's 2-bit border and the gap; measured on 40
   // simulated views: median 0.058 px from truth, 2.5 % of corners over 1 px (a jump to a
   // neighbouring saddle; the solver's outlier rejection drops them), where 0.2 sent 21 % over
   // 1 px. aruco's own corners are ~2 px off on these grids (the tag's outline touches the corner
   // squares), so refinement is needed.
+  auto take = [&](const ArucoPass& pass) {
+    wrong += pass.wrong;
+    for (const auto& [id, quad] : pass.tags) {
+      if (tags.count(id)) continue;
+      std::vector<cv::Point2f> corners(quad.begin(), quad.end());
+      refine_corners(gray, corners, shortest_side_px(quad));
+      std::copy(corners.begin(), corners.end(), tags[id].begin());
+      ++aruco;
+    }
+    quads += read_quads(gray, t, pattern, object, pass.unread, tags);
+    completed += complete_grid(gray, t, pattern, object, tags);
+  };
+  take(aruco_pass(gray, t, 1.0));
+  if (static_cast<int>(tags.size()) < n_tags) {
+    // Tags of under ~25 px (2.5 px a bit) are rarely decoded, and a grid whose every tag is that
+    // small leaves nothing to grow from: aruco again at twice the size.
+    cv::Mat twice;
+    cv::resize(gray, twice, cv::Size(), 2.0, 2.0, cv::INTER_CUBIC);
+    take(aruco_pass(twice, t, 2.0));
+  }
+  Detection d;
+  if (static_cast<int>(tags.size()) < o.min_tags) {
+    d.note = fmt::format("{} tags of the grid found (fewer than {})", tags.size(), o.min_tags);
+    return d;
+  }
+  std::vector<double> sizes;
+  for (const auto& [id, px] : tags) {
+    const std::array<int, 4> point_ids = tag_point_ids(t, id);
+    for (int k = 0; k < 4; ++k) {
+      d.point_ids.push_back(point_ids[k]);
+      d.pixels.emplace_back(px[k].x, px[k].y);
+    }
+    sizes.push_back(side_px(px));
+  }
   d.square_px = sizes.empty() ? 0.0 : median(sizes);  // empty: no tag with min_tags <= 0
-  const int w = std::clamp(static_cast<int>(0.12 * d.square_px), 2, 11);
-  cv::cornerSubPix(gray, corners, cv::Size(w, w), cv::Size(-1, -1),
-                   cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-4));
-  for (const cv::Point2f& c : corners) d.pixels.emplace_back(c.x, c.y);
-  if (wrong) d.note = fmt::format("{} tags with ids outside the grid ignored", wrong);
+  d.note = fmt::format(
+      "{} tags: {} decoded by aruco, {} read from quads aruco could not decode, {} "
+      "found from their neighbours",
+      tags.size(), aruco, quads, completed);
+  if (wrong) d.note += fmt::format("; {} tags with ids outside the grid ignored", wrong);
   d.found = true;
   return d;
 }

@@ -3,8 +3,11 @@
 // on a downscaled probe (bounded time; no minutes-long search on images without a board), then
 // cornerSubPix at full resolution with a window derived from the observed square size, and the
 // corner order fixed so that point 0 is the target's origin corner. AprilGrids: OpenCV's aruco
-// (DICT_APRILTAG_36h11, 2-bit border), every tag's four corners numbered as Kalibr numbers them,
-// refined the same way; partial boards allowed, ids checked.
+// (DICT_APRILTAG_36h11, 2-bit border), then the quads it could not decode read as the grid's own
+// tags, then the tags it missed predicted from their found neighbours, then all of it again at
+// twice the size if tags are still missing; a tag not decoded by aruco is kept only if the image
+// reads as that tag's printed cells through its refined corners. Every tag's four corners
+// numbered as Kalibr numbers them, refined the same way; partial boards allowed.
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>

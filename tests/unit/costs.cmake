@@ -3,7 +3,7 @@
 # own yet) does not start a 80 s test last while the other core idles. A build's own history,
 # once it has one (Testing/Temporary/CTestCostData.txt), takes over.
 set(rigcal_slow_tests
-    Session.HandEyeRunsRigcalsOdometryOnTheMotionScans 82
+    Session.HandEyeRunsRigcalsOdometryOnTheMotionScans 50
     CheckSim.AnUnchangedRigIsConsistentAndATurnedCameraIsFlaggedOnItself 78
     GroundTruthSim.AShortWalksMarkersAndTrajectoryAgainstTheTruth 49
     Session.CalibrateNamesTheFailedStepThenRerunsOnlyIt 42
