@@ -119,6 +119,16 @@ std::array<int, 4> tag_point_ids(const Target& t, int id) {
 
 using TagCorners = std::array<cv::Point2f, 4>;
 
+// Tag `id`'s four corners on the board (x, y), in tag_point_ids' order.
+TagCorners tag_board_corners(const Target& t, const std::vector<Eigen::Vector3d>& object, int id) {
+  const std::array<int, 4> ids = tag_point_ids(t, id);
+  TagCorners board;
+  for (int k = 0; k < 4; ++k)
+    board[k] =
+        cv::Point2f(static_cast<float>(object[ids[k]].x()), static_cast<float>(object[ids[k]].y()));
+  return board;
+}
+
 // Bilinear intensity at a sub-pixel position inside the image.
 double bilinear(const cv::Mat& gray, double x, double y) {
   const int u = static_cast<int>(std::floor(x)), v = static_cast<int>(std::floor(y));
@@ -139,14 +149,12 @@ double bilinear(const cv::Mat& gray, double x, double y) {
 bool reads_as_printed(const cv::Mat& gray, const Target& t, const Pattern& pattern,
                       const std::vector<Eigen::Vector3d>& object, int id, const TagCorners& px,
                       int max_misread) {
-  const std::array<int, 4> ids = tag_point_ids(t, id);
-  std::vector<cv::Point2f> board(4), image(px.begin(), px.end());
-  for (int k = 0; k < 4; ++k)
-    board[k] =
-        cv::Point2f(static_cast<float>(object[ids[k]].x()), static_cast<float>(object[ids[k]].y()));
+  const TagCorners corners = tag_board_corners(t, object, id);
+  const std::vector<cv::Point2f> board(corners.begin(), corners.end()), image(px.begin(), px.end());
   const cv::Matx33d H = cv::getPerspectiveTransform(board, image);
   const Outline o = outline(t);
-  const double x0 = object[ids[3]].x(), y0 = object[ids[3]].y(), cell = t.tag_size / 10.0;
+  const Eigen::Vector3d& origin = object[tag_point_ids(t, id)[3]];  // the tag's corner (2c, 2r)
+  const double x0 = origin.x(), y0 = origin.y(), cell = t.tag_size / 10.0;
   std::vector<std::pair<double, bool>> cells;  // (intensity, printed white)
   for (int j = -1; j <= 10; ++j) {
     for (int i = -1; i <= 10; ++i) {
@@ -228,18 +236,16 @@ int complete_grid(const cv::Mat& gray, const Target& t, const Pattern& pattern,
       near.resize(std::min<size_t>(near.size(), 4));
       std::vector<cv::Point2f> board, image;
       for (const auto& [d, other] : near) {
-        const std::array<int, 4> ids = tag_point_ids(t, other);
-        for (int k = 0; k < 4; ++k) {
-          board.emplace_back(object[ids[k]].x(), object[ids[k]].y());
-          image.push_back(tags[other][k]);
-        }
+        const TagCorners on_board = tag_board_corners(t, object, other);
+        board.insert(board.end(), on_board.begin(), on_board.end());
+        image.insert(image.end(), tags[other].begin(), tags[other].end());
       }
       const cv::Mat H = cv::findHomography(board, image, 0);
       if (H.empty()) continue;
-      const std::array<int, 4> ids = tag_point_ids(t, id);
-      std::vector<cv::Point2f> corner_board, predicted;
-      for (int k = 0; k < 4; ++k) corner_board.emplace_back(object[ids[k]].x(), object[ids[k]].y());
-      cv::perspectiveTransform(corner_board, predicted, H);
+      const TagCorners on_board = tag_board_corners(t, object, id);
+      std::vector<cv::Point2f> predicted;
+      cv::perspectiveTransform(std::vector<cv::Point2f>(on_board.begin(), on_board.end()),
+                               predicted, H);
       TagCorners px;
       std::copy(predicted.begin(), predicted.end(), px.begin());
       const double side = side_px(px);
