@@ -87,6 +87,8 @@ void add_calibrate(CLI::App& app) {
   cmd->add_option("--bayer", o->bayer, "raw Bayer images: rggb | bggr | grbg | gbrg");
   cmd->add_flag("--board-warp", o->run.cameras.board_warp,
                 "cameras: solve the board's warp too (mrcal's calobject_warp; doc/cameras.md)");
+  cmd->add_flag("--saddle-fit", o->run.cameras.saddle_fit,
+                "cameras: checkerboard corners also fitted as saddles (doc/cameras.md)");
   cmd->add_option("--lidar-camera", o->run.lidar_camera.camera,
                   "the camera of the LiDAR-camera step")
       ->capture_default_str();

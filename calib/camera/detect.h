@@ -27,6 +27,15 @@ struct Detection {
 struct DetectOptions {
   int probe_max_size = 800;  // the probe image's larger side, px
   int min_tags = 4;          // AprilGrid: fewer decoded tags count as no detection
+  // Checkerboards: after cornerSubPix, each corner located by a model of its grey values
+  // (saddle.h; `rigcal cameras --saddle-fit`). Measured (doc/cameras.md): on the simulator's
+  // default session 0.024 px of corner noise against 0.050, no pixel locking; on the OpenCV
+  // stereo samples an RMS of 0.180 px against 0.194, but no better agreement between two halves
+  // of the views, and on the ACFR fisheye a worse one; over 20 simulated seeds the equidistant
+  // model's covariance then misses the efficiency bar: off until real data show a gain. Not for
+  // AprilGrids (discs limited by the tags' borders: precision varying with the tags' sizes, and
+  // the reported uncertainty then too small).
+  bool fit_saddles = false;
 };
 
 // `gray`: 8-bit single channel. Never throws for an image without a target (found = false).

@@ -14,10 +14,12 @@
 namespace rigcal::camera {
 namespace {
 
-std::string target_header(const Target& t) {
-  return fmt::format("# rigcal corners of target {} ({} {} x {})", t.name,
+// The saddle fit is named: a cache of the other refinement does not match, and its images are
+// detected again.
+std::string target_header(const Target& t, bool saddle_fit) {
+  return fmt::format("# rigcal corners of target {} ({} {} x {}){}", t.name,
                      t.type == TargetType::checkerboard ? "checkerboard" : "aprilgrid", t.cols,
-                     t.rows);
+                     t.rows, saddle_fit ? ", saddle fit" : "");
 }
 
 cv::Mat colour(const cv::Mat& values_0_1) {
@@ -30,9 +32,9 @@ cv::Mat colour(const cv::Mat& values_0_1) {
 }  // namespace
 
 std::string corners_vnl(const Target& target, const std::vector<std::string>& images,
-                        const std::vector<Detection>& detections) {
+                        const std::vector<Detection>& detections, bool saddle_fit) {
   const size_t n = object_points(target).size();
-  std::string out = target_header(target) + "\n# filename x y level\n";
+  std::string out = target_header(target, saddle_fit) + "\n# filename x y level\n";
   for (size_t i = 0; i < images.size(); ++i) {
     const Detection& d = detections[i];
     if (!d.found) {
@@ -50,9 +52,10 @@ std::string corners_vnl(const Target& target, const std::vector<std::string>& im
   return out;
 }
 
-std::map<std::string, Detection> parse_corners_vnl(std::string_view text, const Target& target) {
+std::map<std::string, Detection> parse_corners_vnl(std::string_view text, const Target& target,
+                                                   bool saddle_fit) {
   std::map<std::string, Detection> out;
-  if (text.substr(0, text.find('\n')) != target_header(target)) return out;
+  if (text.substr(0, text.find('\n')) != target_header(target, saddle_fit)) return out;
   const size_t n = object_points(target).size();
   std::map<std::string, std::vector<std::string_view>> lines;
   std::vector<std::string> order;

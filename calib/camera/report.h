@@ -15,10 +15,14 @@
 namespace rigcal::camera {
 
 // One detection a named image; mrcal reads this file with --corners-cache.
+// `saddle_fit`: the corners were fitted as saddles (DetectOptions::fit_saddles), which the
+// header says: a cache holds for a run only when written with the same refinement.
 std::string corners_vnl(const Target& target, const std::vector<std::string>& images,
-                        const std::vector<Detection>& detections);
-// Detections by image name, when the file was written for this target (else empty).
-std::map<std::string, Detection> parse_corners_vnl(std::string_view text, const Target& target);
+                        const std::vector<Detection>& detections, bool saddle_fit = false);
+// Detections by image name, when the file was written for this target and refinement (else
+// empty).
+std::map<std::string, Detection> parse_corners_vnl(std::string_view text, const Target& target,
+                                                   bool saddle_fit = false);
 
 struct CameraReportInput {
   std::vector<std::string> camera_names;

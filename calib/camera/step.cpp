@@ -92,7 +92,7 @@ Detections detect_all(const Target& target, const io::ImageSet& in, const StepOp
   const size_t n_cams = in.names.size(), n_frames = in.files[0].size();
   std::map<std::string, Detection> cache;
   if (!cache_path.empty() && std::filesystem::exists(cache_path))
-    cache = parse_corners_vnl(io::read_text_file(cache_path), target);
+    cache = parse_corners_vnl(io::read_text_file(cache_path), target, o.saddle_fit);
   Detections d;
   for (size_t c = 0; c < n_cams; ++c) {
     for (size_t f = 0; f < n_frames; ++f) {
@@ -116,7 +116,9 @@ Detections detect_all(const Target& target, const io::ImageSet& in, const StepOp
       d.cameras[c].frames[f] = it->second;
       ++from_cache;
     } else {
-      d.cameras[c].frames[f] = detect(img, target);
+      DetectOptions detect_options;
+      detect_options.fit_saddles = o.saddle_fit;
+      d.cameras[c].frames[f] = detect(img, target, detect_options);
     }
     const size_t k = ++done;
     std::lock_guard<std::mutex> lock(tell);
@@ -374,7 +376,8 @@ report::StepResult calibrate_cameras(const StepInputs& in, const StepOptions& o,
       }
     }
   }
-  out.report_files.push_back({"corners.vnl", corners_vnl(target, all_images, all_detections)});
+  out.report_files.push_back(
+      {"corners.vnl", corners_vnl(target, all_images, all_detections, o.saddle_fit)});
   out.report_files.push_back({"residuals.csv", residuals_csv(r, names)});
   out.report_files.push_back({"cameras.json", report::json_text(out.report)});
   report::finish_report(out, "cameras.json");

@@ -18,6 +18,7 @@ struct StepOptions {
   std::string model = "pinhole-radtan";
   double outlier_sigma = 4.0;         // corners beyond this many sigma are dropped
   bool board_warp = false;            // solve the board's warp (calibrate.h)
+  bool saddle_fit = false;            // checkerboards: DetectOptions::fit_saddles (detect.h)
   io::Bayer bayer = io::Bayer::none;  // raw mosaics: demosaiced to gray
   // Also the detections fitted to the given rig's lenses and stereo poses, only the boards free
   // (rigcal check: the new data at the stored calibration): the report's `at_rig` and the

@@ -250,6 +250,8 @@ std::vector<Plan> make_plans(const CalibrateOptions& o, const io::Session& s,
         fmt::format("model {} outlier_sigma {} bayer {} fit_at_rig {} board_warp {}",
                     o.cameras.model, o.cameras.outlier_sigma, io::to_string(o.cameras.bayer),
                     o.cameras.fit_at_rig, o.cameras.board_warp);
+    // Named only when on: a session cached before the option existed stays cached.
+    if (o.cameras.saddle_fit) p.options += " saddle_fit 1";
     p.reuse_detections = std::make_shared<bool>(false);
     p.run = [rec, target, out, opt = o.cameras, reuse = p.reuse_detections](
                 const rig::Rig& rig, const report::Progress& pr) {
