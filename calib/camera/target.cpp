@@ -108,6 +108,24 @@ Pattern::Pattern(const Target& target) : target_(target) {
   tag36h11_destroy(family);
 }
 
+std::pair<long, long> Pattern::cell(double x, double y) const {
+  const Target& t = target_;
+  if (t.type == TargetType::checkerboard)
+    return {static_cast<long>(std::floor(x / t.square)),
+            static_cast<long>(std::floor(y / t.square))};
+  const double gap = t.tag_size * t.tag_spacing, pitch = t.tag_size + gap;
+  // Along each axis: 11 cells a pitch, the gap then the tag's 10 cells (as albedo reads them).
+  auto along = [&](double z) {
+    const double u = z + gap;
+    const long c = static_cast<long>(std::floor(u / pitch));
+    const double du = u - c * pitch;
+    const long k =
+        du < gap ? 0 : 1 + std::clamp(static_cast<long>((du - gap) / t.tag_size * 10.0), 0L, 9L);
+    return c * 11 + k;
+  };
+  return {along(x), along(y)};
+}
+
 double Pattern::albedo(double x, double y) const {
   const Target& t = target_;
   if (t.type == TargetType::checkerboard) {

@@ -72,6 +72,10 @@ class Pattern {
  public:
   explicit Pattern(const Target& target);
   double albedo(double x, double y) const;
+  // The axis-aligned cell of the pattern's finest grid holding (x, y) (squares; an AprilGrid's
+  // gaps and its tags' 10 x 10 cells), as two integers: albedo is constant within a cell, so
+  // points of one cell share it, and so does everything in their convex hull.
+  std::pair<long, long> cell(double x, double y) const;
 
  private:
   Target target_;

@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
 
+#include <array>
+#include <cmath>
 #include <opencv2/imgproc.hpp>
 
 #include "rigcal/camera/lens.h"
@@ -190,6 +192,45 @@ cv::Mat render_board(const PixelRays& rays, const camera::Target& target,
         }
       }
       double sum = 0.0;
+      if (flat && S > 1) {
+        // Most pixels see one cell of the pattern, or the background, whole: where the four
+        // outermost samples meet the board in one cell (or all miss its outline on one side),
+        // so do the samples between them (the samples' rays are an affine grid, the plane's
+        // hits a projective image of it: inside the four's convex hull), and every sample has
+        // the value of the first. Summed S x S times all the same, as below: the same image.
+        const double h = 0.5 - 0.5 / S;
+        std::array<Eigen::Vector2d, 4> hit;
+        bool all_hit = true;
+        for (int k = 0; k < 4 && all_hit; ++k) {
+          const Eigen::Vector2d xn =
+              rays.xn[i] + rays.dxn_dpixel[i] * Eigen::Vector2d(k & 1 ? h : -h, k & 2 ? h : -h);
+          all_hit = plane_hit(Eigen::Vector3d(xn.x(), xn.y(), 1.0), hit[k].x(), hit[k].y());
+        }
+        if (all_hit) {
+          bool inside = true, left = true, right = true, below = true, above = true,
+               one_cell = true;
+          const auto first = pattern.cell(hit[0].x(), hit[0].y());
+          for (const Eigen::Vector2d& b : hit) {
+            inside = inside && b.x() >= o.x_min && b.x() <= o.x_max && b.y() >= o.y_min &&
+                     b.y() <= o.y_max;
+            left = left && b.x() < o.x_min, right = right && b.x() > o.x_max;
+            below = below && b.y() < o.y_min, above = above && b.y() > o.y_max;
+            one_cell = one_cell && pattern.cell(b.x(), b.y()) == first;
+          }
+          double value = NAN;
+          if (inside && one_cell)
+            value = cfg.black_dn +
+                    (cfg.white_dn - cfg.black_dn) * pattern.albedo(hit[0].x(), hit[0].y());
+          else if (left || right || below || above)
+            value = cfg.background_dn;
+          if (!std::isnan(value)) {
+            for (int k = 0; k < S * S; ++k) sum += value;
+            const double du = u - 0.5 * (rays.width - 1), dv = v - 0.5 * (rays.height - 1);
+            row[u] = sum / (S * S) * (1.0 - cfg.vignetting * (du * du + dv * dv) / r_corner2);
+            continue;
+          }
+        }
+      }
       for (int sy = 0; sy < S; ++sy) {
         for (int sx = 0; sx < S; ++sx) {
           const Eigen::Vector2d off((sx + 0.5) / S - 0.5, (sy + 0.5) / S - 0.5);
