@@ -25,22 +25,20 @@ int subpix_half_window(double feature_px) {
 
 // Each corner located by the saddle fit (saddle.h) in a disc of `radius_px`, at most
 // kSaddleDiscMaxPx, where the fit converges within a pixel of cornerSubPix's estimate; elsewhere
-// cornerSubPix's is kept. Returns how many were fitted. Discs under 2.5 px (too few pixels for
-// seven parameters) are not tried. The cap, measured on the simulator's default session (seed 1,
-// 40 stereo views of the A3 board; doc/cameras.md): corner noise 0.029 / 0.024 / 0.020 /
-// 0.015 px with discs of 3 / 4 / 5 / up to 10 px, against 0.050 px for cornerSubPix alone; on a
-// board bent by (4, -2) mm the edges' curvature then biases the left camera's cy by 1.9 / 2.4 /
-// 3.0 / 5.5 of its reported sigma. Four keeps every parameter within 3 sigma there.
+// cornerSubPix's is kept. Discs under 2.5 px (too few pixels for seven parameters) are not
+// tried. The cap, measured on the simulator's default session (seed 1, 40 stereo views of the A3
+// board; doc/cameras.md): corner noise 0.029 / 0.024 / 0.020 / 0.015 px with discs of 3 / 4 / 5
+// / up to 10 px, against 0.050 px for cornerSubPix alone; on a board bent by (4, -2) mm the
+// edges' curvature then biases the left camera's cy by 1.9 / 2.4 / 3.0 / 5.5 of its reported
+// sigma. Four keeps every parameter within 3 sigma there.
 constexpr double kSaddleDiscMaxPx = 4.0;
 
-int fit_saddles(const cv::Mat& gray, Eigen::Vector2d* px, int n, double radius_px) {
-  if (radius_px < 2.5) return 0;
-  int fitted = 0;
-  for (int i = 0; i < n; ++i) {
-    const SaddleFit f = fit_saddle(gray, px[i], std::min(radius_px, kSaddleDiscMaxPx));
-    if (f.ok) px[i] = f.corner, ++fitted;
+void fit_saddles(const cv::Mat& gray, std::vector<Eigen::Vector2d>& corners, double radius_px) {
+  if (radius_px < 2.5) return;
+  for (Eigen::Vector2d& c : corners) {
+    const SaddleFit f = fit_saddle(gray, c, std::min(radius_px, kSaddleDiscMaxPx));
+    if (f.ok) c = f.corner;
   }
-  return fitted;
 }
 
 // Mean intensity in a small disc, or -1 outside the image.
@@ -101,8 +99,7 @@ Detection detect_checkerboard(const cv::Mat& gray, const Target& t, const Detect
   std::vector<Eigen::Vector2d> px;
   for (const cv::Point2f& c : corners) px.emplace_back(c.x, c.y);
   // The squares are the saddle's quadrants: the disc stays a blur's width inside them.
-  if (o.fit_saddles)
-    fit_saddles(gray, px.data(), static_cast<int>(px.size()), 0.5 * d.square_px - 1.5);
+  if (o.fit_saddles) fit_saddles(gray, px, 0.5 * d.square_px - 1.5);
   // Point 0 must be the origin corner. OpenCV may start at either end (a half turn). The first
   // interior square, between corners 0, 1, cols and cols + 1, is black (doc/targets.md); for a
   // board with cols + rows odd, the square at the other end is white. Interior squares are always

@@ -107,30 +107,16 @@ SaddleFit fit_saddle(const cv::Mat& gray, const Eigen::Vector2d& start, double r
         pixels.push_back({double(u), double(v), double(gray.at<uint8_t>(v, u))});
     }
   }
-  fit.pixels = static_cast<int>(pixels.size());
   if (pixels.size() < 16) return fit;
   std::array<double, 2> theta;
   if (!edge_normals(gray, start, std::max(1.5, 0.7 * radius_px), theta)) return fit;
   Vector7 p;
   p << start.x(), start.y(), theta[0], theta[1], 1.0, 0.0, 0.0;
-  {
-    // a and b, linear given the rest.
-    Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
-    Eigen::Vector2d y = Eigen::Vector2d::Zero();
-    const double k = 1.0 / (std::sqrt(2.0) * p[4]);
-    for (const Pixel& px : pixels) {
-      const double dx = px.x - p[0], dy = px.y - p[1];
-      const double e = std::erf(k * (std::cos(p[2]) * dx + std::sin(p[2]) * dy)) *
-                       std::erf(k * (std::cos(p[3]) * dx + std::sin(p[3]) * dy));
-      const Eigen::Vector2d j(1.0, e);
-      A += j * j.transpose();
-      y += j * px.value;
-    }
-    const Eigen::Vector2d ab = A.ldlt().solve(y);
-    p[5] = ab[0], p[6] = ab[1];
-  }
   Matrix7 JtJ;
   Vector7 Jtr;
+  // a and b, linear given the rest: one Gauss-Newton step in them alone from a = b = 0.
+  evaluate(pixels, p, &JtJ, &Jtr);
+  p.tail<2>() = JtJ.bottomRightCorner<2, 2>().ldlt().solve(-Jtr.tail<2>());
   double cost = evaluate(pixels, p, &JtJ, &Jtr), lambda = 1e-3;
   bool converged = false;
   for (int it = 0; it < 50 && !converged; ++it) {
@@ -153,7 +139,6 @@ SaddleFit fit_saddle(const cv::Mat& gray, const Eigen::Vector2d& start, double r
   fit.corner = p.head<2>();
   fit.blur_px = p[4];
   fit.contrast_dn = std::abs(p[6]);
-  fit.rms_dn = std::sqrt(cost / pixels.size());
   fit.ok = converged && (fit.corner - start).norm() <= max_shift_px && p[4] < 10.0 &&
            fit.contrast_dn > 5.0;
   if (!fit.ok) fit.corner = start;

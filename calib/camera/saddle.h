@@ -28,8 +28,6 @@ struct SaddleFit {
   Eigen::Vector2d corner;  // px, pixel centres at integer coordinates
   double blur_px = 0;      // s: the edges' Gaussian width, pixel area included
   double contrast_dn = 0;  // |b|
-  double rms_dn = 0;       // residual RMS over the disc
-  int pixels = 0;          // in the disc
 };
 
 // `gray` 8-bit single channel; `start` within about a pixel of the corner; `radius_px` the disc

@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 
 #include "rigcal/camera/lens.h"
 #include "rigcal/core/error.h"
@@ -167,6 +168,38 @@ cv::Mat render_board(const PixelRays& rays, const camera::Target& target,
     return moved;
   };
   const int S = std::max(1, cfg.supersample);
+  auto on_board = [&](double bx, double by) {
+    return bx >= o.x_min && bx <= o.x_max && by >= o.y_min && by <= o.y_max;
+  };
+  auto printed = [&](double bx, double by) {
+    return cfg.black_dn + (cfg.white_dn - cfg.black_dn) * pattern.albedo(bx, by);
+  };
+  // The one value every sample of pixel i has on a flat board, where the pixel sees one cell of
+  // the pattern, or the background, whole: the four outermost samples meet the board in one cell
+  // (or all miss its outline on one side), so the samples between them do too (the samples' rays
+  // are an affine grid, the plane's hits a projective image of it: inside the four's convex
+  // hull). Most pixels are such; nothing where they are not.
+  auto one_value = [&](size_t i) -> std::optional<double> {
+    const double h = 0.5 - 0.5 / S;
+    std::array<Eigen::Vector2d, 4> hit;
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector2d xn =
+          rays.xn[i] + rays.dxn_dpixel[i] * Eigen::Vector2d(k & 1 ? h : -h, k & 2 ? h : -h);
+      if (!plane_hit(Eigen::Vector3d(xn.x(), xn.y(), 1.0), hit[k].x(), hit[k].y()))
+        return std::nullopt;
+    }
+    bool inside = true, left = true, right = true, below = true, above = true, one_cell = true;
+    const auto first = pattern.cell(hit[0].x(), hit[0].y());
+    for (const Eigen::Vector2d& b : hit) {
+      inside = inside && on_board(b.x(), b.y());
+      left = left && b.x() < o.x_min, right = right && b.x() > o.x_max;
+      below = below && b.y() < o.y_min, above = above && b.y() > o.y_max;
+      one_cell = one_cell && pattern.cell(b.x(), b.y()) == first;
+    }
+    if (inside && one_cell) return printed(hit[0].x(), hit[0].y());
+    if (left || right || below || above) return cfg.background_dn;
+    return std::nullopt;
+  };
   cv::Mat signal(rays.height, rays.width, CV_64F);
   const double r_corner2 =
       0.25 * (double(rays.width) * rays.width + double(rays.height) * rays.height);
@@ -192,61 +225,24 @@ cv::Mat render_board(const PixelRays& rays, const camera::Target& target,
         }
       }
       double sum = 0.0;
-      if (flat && S > 1) {
-        // Most pixels see one cell of the pattern, or the background, whole: where the four
-        // outermost samples meet the board in one cell (or all miss its outline on one side),
-        // so do the samples between them (the samples' rays are an affine grid, the plane's
-        // hits a projective image of it: inside the four's convex hull), and every sample has
-        // the value of the first. Summed S x S times all the same, as below: the same image.
-        const double h = 0.5 - 0.5 / S;
-        std::array<Eigen::Vector2d, 4> hit;
-        bool all_hit = true;
-        for (int k = 0; k < 4 && all_hit; ++k) {
-          const Eigen::Vector2d xn =
-              rays.xn[i] + rays.dxn_dpixel[i] * Eigen::Vector2d(k & 1 ? h : -h, k & 2 ? h : -h);
-          all_hit = plane_hit(Eigen::Vector3d(xn.x(), xn.y(), 1.0), hit[k].x(), hit[k].y());
-        }
-        if (all_hit) {
-          bool inside = true, left = true, right = true, below = true, above = true,
-               one_cell = true;
-          const auto first = pattern.cell(hit[0].x(), hit[0].y());
-          for (const Eigen::Vector2d& b : hit) {
-            inside = inside && b.x() >= o.x_min && b.x() <= o.x_max && b.y() >= o.y_min &&
-                     b.y() <= o.y_max;
-            left = left && b.x() < o.x_min, right = right && b.x() > o.x_max;
-            below = below && b.y() < o.y_min, above = above && b.y() > o.y_max;
-            one_cell = one_cell && pattern.cell(b.x(), b.y()) == first;
-          }
-          double value = NAN;
-          if (inside && one_cell)
-            value = cfg.black_dn +
-                    (cfg.white_dn - cfg.black_dn) * pattern.albedo(hit[0].x(), hit[0].y());
-          else if (left || right || below || above)
-            value = cfg.background_dn;
-          if (!std::isnan(value)) {
-            for (int k = 0; k < S * S; ++k) sum += value;
-            const double du = u - 0.5 * (rays.width - 1), dv = v - 0.5 * (rays.height - 1);
-            row[u] = sum / (S * S) * (1.0 - cfg.vignetting * (du * du + dv * dv) / r_corner2);
-            continue;
-          }
-        }
-      }
-      for (int sy = 0; sy < S; ++sy) {
-        for (int sx = 0; sx < S; ++sx) {
-          const Eigen::Vector2d off((sx + 0.5) / S - 0.5, (sy + 0.5) / S - 0.5);
-          const Eigen::Vector2d xn = rays.xn[i] + rays.dxn_dpixel[i] * off;
-          const Eigen::Vector3d ray(xn.x(), xn.y(), 1.0);
-          double value = cfg.background_dn, bx, by;
-          if (plane_hit(ray, bx, by)) {
-            if (warp_here) {
-              bx += shift.x(), by += shift.y();
-              warp_step(ray, bx, by);
+      if (const std::optional<double> value = flat && S > 1 ? one_value(i) : std::nullopt) {
+        for (int k = 0; k < S * S; ++k) sum += *value;  // as the samples would sum: the same image
+      } else {
+        for (int sy = 0; sy < S; ++sy) {
+          for (int sx = 0; sx < S; ++sx) {
+            const Eigen::Vector2d off((sx + 0.5) / S - 0.5, (sy + 0.5) / S - 0.5);
+            const Eigen::Vector2d xn = rays.xn[i] + rays.dxn_dpixel[i] * off;
+            const Eigen::Vector3d ray(xn.x(), xn.y(), 1.0);
+            double value = cfg.background_dn, bx, by;
+            if (plane_hit(ray, bx, by)) {
+              if (warp_here) {
+                bx += shift.x(), by += shift.y();
+                warp_step(ray, bx, by);
+              }
+              if (on_board(bx, by)) value = printed(bx, by);
             }
-            if (bx >= o.x_min && bx <= o.x_max && by >= o.y_min && by <= o.y_max) {
-              value = cfg.black_dn + (cfg.white_dn - cfg.black_dn) * pattern.albedo(bx, by);
-            }
+            sum += value;
           }
-          sum += value;
         }
       }
       const double du = u - 0.5 * (rays.width - 1), dv = v - 0.5 * (rays.height - 1);
