@@ -17,7 +17,7 @@ namespace fs = std::filesystem;
 struct Options {
   gt::InputFiles in;
   gt::StepOptions step;
-  std::string out, sigmas, report, map, enu_origin, fix_correlation = "auto";
+  std::string out, sigmas, report, map, enu_origin, fix_correlation = "auto", fix_model = "states";
   bool no_bundle_adjustment = false, no_fusion = false;
   std::pair<size_t, size_t> windows{0, 0};  // FROM:TO; 0:0 all
 };
@@ -30,6 +30,7 @@ void run(Options o) {
     o.step.enu_origin = io::parse_geodetic_origin(o.enu_origin, "--enu-origin");
   o.step.pose_graph.fix_correlation_s =
       o.fix_correlation == "auto" ? -1.0 : parse_double(o.fix_correlation, "--fix-correlation");
+  o.step.pose_graph.fix_error_states = o.fix_model == "states";
   if (o.windows != std::pair<size_t, size_t>{0, 0})
     std::tie(o.step.ba.first_window, o.step.ba.end_window) = o.windows;
   const gt::CommandOutcome r =
@@ -84,10 +85,17 @@ void add_ground_truth(CLI::App& app) {
       ->check(seconds_within(1e-6, 60))
       ->capture_default_str();
   cmd->add_option("--fix-correlation", o->fix_correlation,
-                  "the fixes' error correlation time, s: each prior weighs as 1 / (2 S x scan "
-                  "rate) of an independent one (0: independent; auto: estimated from the "
-                  "residuals of the solves, each solved again with it until it settles)")
+                  "the fixes' error correlation time S, s (0: independent; auto: estimated from "
+                  "the residuals of the solves, each solved again with it until it settles)")
       ->check(CLI::IsMember({"auto"}) | seconds_within(0, 600))
+      ->capture_default_str();
+  cmd->add_option("--fix-model", o->fix_model,
+                  "how correlated fixes weigh: states (their error a Gauss-Markov state of "
+                  "correlation time S at every scan, in units of each fix's sigmas, part of its "
+                  "variance white: with --fix-correlation auto, S and that part the most likely, "
+                  "else 10 %) or scaled (each prior weighs as 1 / (2 S x scan rate) of an "
+                  "independent one)")
+      ->check(CLI::IsMember({"states", "scaled"}))
       ->capture_default_str();
   cmd->add_option("--scans", o->in.scans,
                   "the scans (a folder, a capture, a recording; default: the recording's)");

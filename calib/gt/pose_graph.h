@@ -27,6 +27,19 @@ struct PoseGraphConfig {
   // fixes' errors taken as independent. (The ground- truth step reads a negative value as: estimate
   // it, estimate_fix_correlation.)
   double fix_correlation_s = 0.0;
+  // How the final solve (after the gate) takes correlated fixes (fix_correlation_s > 0): true,
+  // as an error state per scan (a first-order Gauss-Markov process in units of each fix's
+  // sigmas, gt/fix_error_state.h); false, by the covariance scaling above. The robust first
+  // solve, whose residuals gate the priors, always uses the scaling.
+  bool fix_error_states = true;
+  // The share of a fix's variance that is white (independent from fix to fix) when its error is
+  // a state; the rest is the Gauss-Markov process. The likelihood search below starts here.
+  double fix_white_fraction = 0.1;
+  // With the fixes' error as states: take the correlation time and the white share that make the
+  // fixes and motions most likely (the final solve's marginal likelihood, the poses and states
+  // integrated out; the time searched over 0.2-60 s, the share over 1e-4-0.5, about 36 solves).
+  // fix_correlation_s still sets the first, robust solve's scaling and so the gate.
+  bool fix_correlation_by_likelihood = false;
   // The fixes' spread (m, standard deviation) below which they are taken as a point (a
   // standing rig: no heading, the odometry's rotation held) or a line (the start rotation
   // from the line's direction; the roll about it judged by max_rotation_sigma_deg).
@@ -79,5 +92,9 @@ PoseGraphResult solve_pose_graph(const OdometryInput& odometry,
 // (n - 1). O(n); none when H is singular.
 std::vector<Matrix6d> chain_marginals(const std::vector<Matrix6d>& D,
                                       const std::vector<Matrix6d>& B);
+// The same with a pose and its fix error state a block (9 x 9).
+using Matrix9d = Eigen::Matrix<double, 9, 9>;
+std::vector<Matrix9d> chain_marginals(const std::vector<Matrix9d>& D,
+                                      const std::vector<Matrix9d>& B);
 
 }  // namespace rigcal::gt

@@ -181,10 +181,17 @@ GroundTruthRun run_ground_truth(const StepInputs& in, const StepOptions& o,
       config.fix_correlation_s = tau;
       g = solve_pose_graph(motions, run.fixes, run.p_lidar_antenna, config);
     }
-    run.fix_correlation_s = config.fix_correlation_s;
+    // With the fixes' error as states, the time that makes the fixes most likely (the loop's
+    // estimate still sets the gate's first solve).
+    if (config.fix_error_states) {
+      config.fix_correlation_by_likelihood = true;
+      g = solve_pose_graph(motions, run.fixes, run.p_lidar_antenna, config);
+    }
+    run.fix_correlation_s = g.fix_correlation_s;
     return g;
   };
   run.fix_correlation_s = o.pose_graph.fix_correlation_s;
+  run.fix_error_states = o.pose_graph.fix_error_states;
   report::tell(progress, "solving the pose graph", 0, 1);
   run.graph = solve(odometry);
   report::tell(progress, "solving the pose graph", 1, 1);
@@ -351,6 +358,9 @@ nlohmann::json ground_truth_report(const GroundTruthRun& run, const StepInputs& 
       {"fix_correlation_s", run.fix_correlation_s},
       {"fix_correlation",
        run.fix_correlation_estimated ? "estimated from the solves' prior residuals" : "given"},
+      {"fix_model", !(run.fix_correlation_s > 0) ? "independent"
+                    : run.fix_error_states       ? "a Gauss-Markov error state at every scan"
+                                                 : "each prior's covariance scaled"},
       {"solver_iterations", g.iterations},
       {"seconds", run.seconds}};
   if (run.ba) {
@@ -506,8 +516,9 @@ std::string ground_truth_summary(const GroundTruthRun& run, const nlohmann::json
                        1e3 * s["prior_residual_horizontal_m"]["rms"].get<double>(),
                        1e3 * s["prior_residual_vertical_m"]["rms"].get<double>());
   }
-  out += fmt::format("the fixes' error correlation time: {:.1f} s ({})\n", run.fix_correlation_s,
-                     s["fix_correlation"].get<std::string>());
+  out += fmt::format("the fixes' error correlation time: {:.1f} s ({}); their errors: {}\n",
+                     run.fix_correlation_s, s["fix_correlation"].get<std::string>(),
+                     s["fix_model"].get<std::string>());
   if (!s["pose_sigma_horizontal_m"].is_null()) {
     out += fmt::format(
         "pose sigmas: horizontal median {:.1f} mm (max {:.1f}), yaw median {:.3f} deg\n",

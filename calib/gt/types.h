@@ -63,6 +63,10 @@ struct PoseGraphResult {
   std::vector<std::string> notes;
   int iterations = 0;
   double initial_cost = 0, final_cost = 0;
+  // The fixes' correlation time the final solve used, s (the configuration's, or the most
+  // likely one when PoseGraphConfig::fix_correlation_by_likelihood).
+  double fix_correlation_s = 0;
+  double fix_white_fraction = 0;  // of a fix's variance, when its error is a state
 };
 
 }  // namespace rigcal::gt

@@ -38,14 +38,16 @@ struct Input {
   Eigen::Vector3d p_lidar_antenna;
 };
 
-const Input& walk(double seconds) {
-  static std::map<double, Input> cache;
-  auto it = cache.find(seconds);
+// `correlation_s` > 0: the fixes' errors correlated over that time (first-order Gauss-Markov).
+const Input& walk(double seconds, double correlation_s = 0.0) {
+  static std::map<std::pair<double, double>, Input> cache;
+  auto it = cache.find({seconds, correlation_s});
   if (it != cache.end()) return it->second;
   const rig::Rig rig = rig::read_rig_file(RIGCAL_SOURCE_DIR "/data/sample_rig.yaml");
   sim::SimConfig cfg;
   cfg.trajectory_duration_s = seconds;
   cfg.gnss.outages = {{0.4 * seconds, 0.4 * seconds + 20.0}};
+  cfg.gnss.correlation_time_s = correlation_s;
   const sim::TrajectoryPart part = sim::simulate_trajectories(rig, cfg);
   const rig::Sensor& gnss = rig::sensor(rig, part.gnss_name);
   Input in;
@@ -58,7 +60,7 @@ const Input& walk(double seconds) {
       (Eigen::Matrix<double, 6, 1>() << r * r, r * r, r * r, t * t, t * t, t * t)
           .finished()
           .asDiagonal());
-  return cache.emplace(seconds, std::move(in)).first->second;
+  return cache.emplace(std::make_pair(seconds, correlation_s), std::move(in)).first->second;
 }
 
 void BM_PoseGraph(benchmark::State& state) {
@@ -73,6 +75,26 @@ void BM_PoseGraph(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_PoseGraph)->Arg(600)->Arg(3600)->Unit(benchmark::kMillisecond)->Iterations(1);
+
+// Fixes correlated over 5 s, their error a state at every scan, the correlation time and the
+// white share by likelihood (the ground-truth step's default with --fix-correlation auto, its
+// gate's solve given the 2 s a residual estimate gives).
+void BM_PoseGraphFixStates(benchmark::State& state) {
+  const Input& in = walk(g_smoke ? 120.0 : double(state.range(0)), 5.0);
+  gt::PoseGraphConfig config;
+  config.fix_correlation_s = 2.0;
+  config.fix_correlation_by_likelihood = true;
+  for (auto _ : state) {
+    const gt::PoseGraphResult r =
+        gt::solve_pose_graph(in.odometry, in.fixes, in.p_lidar_antenna, config);
+    benchmark::DoNotOptimize(r.covariance.data());
+    state.counters["poses"] = double(r.T_enu_lidar.size());
+    state.counters["iterations"] = double(r.iterations);
+    state.counters["tau_s"] = r.fix_correlation_s;
+    state.counters["white"] = r.fix_white_fraction;
+  }
+}
+BENCHMARK(BM_PoseGraphFixStates)->Arg(600)->Arg(3600)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 void BM_BundleAdjustment(benchmark::State& state) {
   if (g_smoke && state.range(0) != 1) {  // one small run is enough to keep it from rotting
