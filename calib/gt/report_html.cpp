@@ -229,7 +229,11 @@ std::string ground_truth_html(const json& r, const std::string& top_view_svg) {
       {"the fixes' error correlation time",
        fmt::format("{} s ({})", html_number(s["fix_correlation_s"], "{:.1f}"),
                    html_escape(s.value("fix_correlation", "")))},
-      {"the fixes' errors", html_escape(s.value("fix_model", ""))},
+      {"the fixes' errors",
+       s.value("fix_white_share", 0.0) > 0
+           ? fmt::format("{}, {} of their variance white", html_escape(s.value("fix_model", "")),
+                         html_number(s["fix_white_share"], "{:.2g}"))
+           : html_escape(s.value("fix_model", ""))},
       {"pose 1-sigma, horizontal median / max [mm]",
        median_max(s["pose_sigma_horizontal_m"], "{:.1f}", 1e3)},
       {"pose 1-sigma, vertical median / max [mm]",

@@ -167,8 +167,11 @@ GroundTruthRun run_ground_truth(const StepInputs& in, const StepOptions& o,
   // as independent, then solved again with it.
   auto solve = [&](const OdometryInput& motions) {
     PoseGraphConfig config = o.pose_graph;
-    if (config.fix_correlation_s >= 0)
-      return solve_pose_graph(motions, run.fixes, run.p_lidar_antenna, config);
+    if (config.fix_correlation_s >= 0) {
+      PoseGraphResult g = solve_pose_graph(motions, run.fixes, run.p_lidar_antenna, config);
+      run.fix_white_fraction = g.fix_white_fraction;
+      return g;
+    }
     // A solve that takes the fixes as more independent than they are follows their drift, and
     // its residuals understate the correlation: estimated again from each solve's residuals
     // until it settles (within 10 %, at most 6 solves).
@@ -188,6 +191,7 @@ GroundTruthRun run_ground_truth(const StepInputs& in, const StepOptions& o,
       g = solve_pose_graph(motions, run.fixes, run.p_lidar_antenna, config);
     }
     run.fix_correlation_s = g.fix_correlation_s;
+    run.fix_white_fraction = g.fix_white_fraction;
     return g;
   };
   run.fix_correlation_s = o.pose_graph.fix_correlation_s;
@@ -357,7 +361,11 @@ nlohmann::json ground_truth_report(const GroundTruthRun& run, const StepInputs& 
       {"pose_sigma_yaw_deg", stats(sigma_yaw)},
       {"fix_correlation_s", run.fix_correlation_s},
       {"fix_correlation",
-       run.fix_correlation_estimated ? "estimated from the solves' prior residuals" : "given"},
+       !run.fix_correlation_estimated ? "given"
+       : run.fix_error_states
+           ? "the most likely, with the white share (the final solve's marginal likelihood)"
+           : "estimated from the solves' prior residuals"},
+      {"fix_white_share", run.fix_white_fraction},
       {"fix_model", !(run.fix_correlation_s > 0) ? "independent"
                     : run.fix_error_states       ? "a Gauss-Markov error state at every scan"
                                                  : "each prior's covariance scaled"},
@@ -516,9 +524,12 @@ std::string ground_truth_summary(const GroundTruthRun& run, const nlohmann::json
                        1e3 * s["prior_residual_horizontal_m"]["rms"].get<double>(),
                        1e3 * s["prior_residual_vertical_m"]["rms"].get<double>());
   }
-  out += fmt::format("the fixes' error correlation time: {:.1f} s ({}); their errors: {}\n",
+  out += fmt::format("the fixes' error correlation time: {:.1f} s ({}); their errors: {}",
                      run.fix_correlation_s, s["fix_correlation"].get<std::string>(),
                      s["fix_model"].get<std::string>());
+  if (run.fix_white_fraction > 0)
+    out += fmt::format(", {:.2g} of their variance white", run.fix_white_fraction);
+  out += "\n";
   if (!s["pose_sigma_horizontal_m"].is_null()) {
     out += fmt::format(
         "pose sigmas: horizontal median {:.1f} mm (max {:.1f}), yaw median {:.3f} deg\n",
