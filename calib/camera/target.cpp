@@ -108,47 +108,48 @@ Pattern::Pattern(const Target& target) : target_(target) {
   tag36h11_destroy(family);
 }
 
+namespace {
+
+// Where z lies along one axis of an AprilGrid: the pitch it is in (-1 the margin before the
+// first tag; each pitch is [gap | tag], shifted by one gap) and, within it, 0 in the gap or
+// 1 + the tag's cell (0-9) as printed along the axis.
+std::pair<long, long> aprilgrid_axis(const Target& t, double z) {
+  const double gap = t.tag_size * t.tag_spacing, pitch = t.tag_size + gap;
+  const double u = z + gap;
+  const long c = static_cast<long>(std::floor(u / pitch));
+  const double du = u - c * pitch;  // 0..pitch; the first `gap` is the gap
+  if (du < gap) return {c, 0};
+  return {c, 1 + std::clamp(static_cast<long>((du - gap) / t.tag_size * 10.0), 0L, 9L)};
+}
+
+}  // namespace
+
 std::pair<long, long> Pattern::cell(double x, double y) const {
   const Target& t = target_;
   if (t.type == TargetType::checkerboard)
     return {static_cast<long>(std::floor(x / t.square)),
             static_cast<long>(std::floor(y / t.square))};
-  const double gap = t.tag_size * t.tag_spacing, pitch = t.tag_size + gap;
-  // Along each axis: 11 cells a pitch, the gap then the tag's 10 cells (as albedo reads them).
-  auto along = [&](double z) {
-    const double u = z + gap;
-    const long c = static_cast<long>(std::floor(u / pitch));
-    const double du = u - c * pitch;
-    const long k =
-        du < gap ? 0 : 1 + std::clamp(static_cast<long>((du - gap) / t.tag_size * 10.0), 0L, 9L);
-    return c * 11 + k;
-  };
-  return {along(x), along(y)};
+  const auto [c, kx] = aprilgrid_axis(t, x);
+  const auto [r, ky] = aprilgrid_axis(t, y);
+  return {c * 11 + kx, r * 11 + ky};
 }
 
 double Pattern::albedo(double x, double y) const {
   const Target& t = target_;
   if (t.type == TargetType::checkerboard) {
-    const long i = static_cast<long>(std::floor(x / t.square));
-    const long j = static_cast<long>(std::floor(y / t.square));
+    const auto [i, j] = cell(x, y);
     if (i < -1 || j < -1 || i > t.cols - 1 || j > t.rows - 1) return 1.0;  // margin
     return ((i + j) % 2 == 0) ? 0.0 : 1.0;  // the square diagonal to the origin corner is black
   }
-  const double gap = t.tag_size * t.tag_spacing;
-  const double pitch = t.tag_size + gap;
-  // Which column of tags / gaps: shift by one gap so that each cell is [gap | tag].
-  const double u = x + gap, v = y + gap;
-  const long c = static_cast<long>(std::floor(u / pitch)),
-             r = static_cast<long>(std::floor(v / pitch));
-  const double du = u - c * pitch, dv = v - r * pitch;  // 0..pitch; the first `gap` is the gap
-  const bool in_gap_x = du < gap, in_gap_y = dv < gap;
+  // Tag column c and row r (or the gaps before them), and the cell within.
+  const auto [c, kx] = aprilgrid_axis(t, x);
+  const auto [r, ky] = aprilgrid_axis(t, y);
+  const bool in_gap_x = kx == 0, in_gap_y = ky == 0;
   if (c < 0 || r < 0 || c > t.cols || r > t.rows) return 1.0;  // margin
   if (in_gap_x && in_gap_y) return 0.0;                        // the small squares at tag corners
   if (in_gap_x || in_gap_y || c == t.cols || r == t.rows) return 1.0;
   // Inside tag (c, r): 10 x 10 cells, a 2-cell black border around 6 x 6 data bits.
-  const int cx = std::clamp(static_cast<int>((du - gap) / t.tag_size * 10.0), 0, 9);
-  const int cy_up = std::clamp(static_cast<int>((dv - gap) / t.tag_size * 10.0), 0, 9);
-  const int row = 9 - cy_up;  // printed rows go downwards
+  const long cx = kx - 1, row = 9 - (ky - 1);  // printed rows go downwards
   if (cx < 2 || cx > 7 || row < 2 || row > 7) return 0.0;
   return tag_bits_[r * t.cols + c][(row - 2) * 6 + (cx - 2)];
 }

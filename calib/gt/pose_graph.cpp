@@ -484,6 +484,16 @@ PoseGraphResult solve_pose_graph(const OdometryInput& odometry,
     const SE3 T_enu_lidar = T_enu_odom * scans.T_world_body[k];
     poses[k] = {T_enu_lidar.quaternion(), T_enu_lidar.t};
   }
+  // Each prior's residual at `poses`, against its fix's own covariance (not the
+  // correlation-scaled weight).
+  auto prior_residuals = [&](const std::vector<PoseBlock>& at) {
+    for (size_t j = 0; j < priors.size(); ++j) {
+      PriorResidual& r = out.priors[j];
+      const PoseBlock& b = at[priors[j].node];
+      r.residual_enu = b.q * p_lidar_antenna + b.t - priors[j].p_enu;
+      r.mahalanobis2 = r.residual_enu.dot(priors[j].covariance.ldlt().solve(r.residual_enu));
+    }
+  };
   // Solve 1, robust, its priors' covariances scaled by the correlation; the gate.
   {
     Graph g;
@@ -496,15 +506,11 @@ PoseGraphResult solve_pose_graph(const OdometryInput& odometry,
     out.iterations += int(summary.iterations.size());
     out.initial_cost = summary.initial_cost;
     poses = g.poses;
-    for (size_t j = 0; j < priors.size(); ++j) {
-      PriorResidual& r = out.priors[j];
-      const PoseBlock& b = poses[priors[j].node];
-      r.residual_enu = b.q * p_lidar_antenna + b.t - priors[j].p_enu;
-      // Against the fix's own covariance (not the correlation-scaled weight).
-      r.mahalanobis2 = r.residual_enu.dot(priors[j].covariance.ldlt().solve(r.residual_enu));
-      r.rejected = r.mahalanobis2 > config.gate_chi2;
-    }
+    prior_residuals(poses);
+    for (PriorResidual& r : out.priors) r.rejected = r.mahalanobis2 > config.gate_chi2;
   }
+  const auto kept = std::count_if(out.priors.begin(), out.priors.end(),
+                                  [](const PriorResidual& r) { return !r.rejected; });
   // Solve 2 on the priors kept, from solve 1's poses: plain least squares, the fixes' error a
   // state (their covariances not scaled) or their covariances scaled as in solve 1.
   const bool states = config.fix_error_states &&
@@ -550,8 +556,6 @@ PoseGraphResult solve_pose_graph(const OdometryInput& odometry,
               FixErrorStepError((scans.stamps[k + 1] - scans.stamps[k]).seconds(), tau_s).a;
           f.minus_2_log_likelihood += 3.0 * std::log(std::max(1.0 - a * a, 1e-12));
         }
-        const auto kept = std::count_if(out.priors.begin(), out.priors.end(),
-                                        [](const PriorResidual& r) { return !r.rejected; });
         f.minus_2_log_likelihood += 3.0 * double(kept) * std::log(white_fraction);
       }
     }
@@ -576,7 +580,7 @@ PoseGraphResult solve_pose_graph(const OdometryInput& odometry,
     // Nelder-Mead over (log tau, log white share), both clamped to their ranges (tau 0.2-120 s,
     // the share 1e-4-0.5): the two trade against each other (a white share taken too large
     // makes the errors look smoother than they are, and the time comes out long: measured,
-    // 0.1 for none gives 14-17 s for a true 5 s), so they are searched together; to 3 % in
+    // 0.1 for none gives 14-17 s for a true 5 s), so they are searched together; to 5 % in
     // each (or as alike as the data can tell), at most 60 solves.
     using Point = Eigen::Vector2d;
     const Point lower(std::log(0.2), std::log(1e-4)), upper(std::log(120.0), std::log(0.5));
@@ -637,17 +641,11 @@ PoseGraphResult solve_pose_graph(const OdometryInput& odometry,
   out.fix_white_fraction = states ? white_fraction : 0.0;
   out.final_cost = best.cost;
   poses = std::move(best.poses);
-  for (size_t j = 0; j < priors.size(); ++j) {
-    PriorResidual& r = out.priors[j];
-    const PoseBlock& b = poses[priors[j].node];
-    r.residual_enu = b.q * p_lidar_antenna + b.t - priors[j].p_enu;
-    r.mahalanobis2 = r.residual_enu.dot(priors[j].covariance.ldlt().solve(r.residual_enu));
-  }
+  prior_residuals(poses);
   out.covariance = std::move(best.covariance);
   if (!hold_rotation) judge_rotation(out, spread_axes, config);
   if (!config.covariances) out.covariance.clear();
-  out.rejected = size_t(std::count_if(out.priors.begin(), out.priors.end(),
-                                      [](const PriorResidual& r) { return r.rejected; }));
+  out.rejected = out.priors.size() - size_t(kept);
   out.T_enu_lidar.stamps = scans.stamps;
   out.T_enu_lidar.has_stamps = scans.has_stamps;
   for (const PoseBlock& b : poses)

@@ -37,7 +37,7 @@ struct PoseGraphConfig {
   double fix_white_fraction = 0.1;
   // With the fixes' error as states: take the correlation time and the white share that make the
   // fixes and motions most likely (the final solve's marginal likelihood, the poses and states
-  // integrated out; the time searched over 0.2-60 s, the share over 1e-4-0.5, about 36 solves).
+  // integrated out; the time searched over 0.2-120 s, the share over 1e-4-0.5, about 35 solves).
   // fix_correlation_s still sets the first, robust solve's scaling and so the gate.
   bool fix_correlation_by_likelihood = false;
   // The fixes' spread (m, standard deviation) below which they are taken as a point (a

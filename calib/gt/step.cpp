@@ -167,11 +167,8 @@ GroundTruthRun run_ground_truth(const StepInputs& in, const StepOptions& o,
   // as independent, then solved again with it.
   auto solve = [&](const OdometryInput& motions) {
     PoseGraphConfig config = o.pose_graph;
-    if (config.fix_correlation_s >= 0) {
-      PoseGraphResult g = solve_pose_graph(motions, run.fixes, run.p_lidar_antenna, config);
-      run.fix_white_fraction = g.fix_white_fraction;
-      return g;
-    }
+    if (config.fix_correlation_s >= 0)
+      return solve_pose_graph(motions, run.fixes, run.p_lidar_antenna, config);
     // A solve that takes the fixes as more independent than they are follows their drift, and
     // its residuals understate the correlation: estimated again from each solve's residuals
     // until it settles (within 10 %, at most 6 solves).
@@ -191,11 +188,9 @@ GroundTruthRun run_ground_truth(const StepInputs& in, const StepOptions& o,
       g = solve_pose_graph(motions, run.fixes, run.p_lidar_antenna, config);
     }
     run.fix_correlation_s = g.fix_correlation_s;
-    run.fix_white_fraction = g.fix_white_fraction;
     return g;
   };
   run.fix_correlation_s = o.pose_graph.fix_correlation_s;
-  run.fix_error_states = o.pose_graph.fix_error_states;
   report::tell(progress, "solving the pose graph", 0, 1);
   run.graph = solve(odometry);
   report::tell(progress, "solving the pose graph", 1, 1);
@@ -362,12 +357,12 @@ nlohmann::json ground_truth_report(const GroundTruthRun& run, const StepInputs& 
       {"fix_correlation_s", run.fix_correlation_s},
       {"fix_correlation",
        !run.fix_correlation_estimated ? "given"
-       : run.fix_error_states
+       : g.fix_white_fraction > 0
            ? "the most likely, with the white share (the final solve's marginal likelihood)"
            : "estimated from the solves' prior residuals"},
-      {"fix_white_share", run.fix_white_fraction},
+      {"fix_white_share", g.fix_white_fraction},
       {"fix_model", !(run.fix_correlation_s > 0) ? "independent"
-                    : run.fix_error_states       ? "a Gauss-Markov error state at every scan"
+                    : g.fix_white_fraction > 0   ? "a Gauss-Markov error state at every scan"
                                                  : "each prior's covariance scaled"},
       {"solver_iterations", g.iterations},
       {"seconds", run.seconds}};
@@ -527,8 +522,8 @@ std::string ground_truth_summary(const GroundTruthRun& run, const nlohmann::json
   out += fmt::format("the fixes' error correlation time: {:.1f} s ({}); their errors: {}",
                      run.fix_correlation_s, s["fix_correlation"].get<std::string>(),
                      s["fix_model"].get<std::string>());
-  if (run.fix_white_fraction > 0)
-    out += fmt::format(", {:.2g} of their variance white", run.fix_white_fraction);
+  if (run.graph.fix_white_fraction > 0)
+    out += fmt::format(", {:.2g} of their variance white", run.graph.fix_white_fraction);
   out += "\n";
   if (!s["pose_sigma_horizontal_m"].is_null()) {
     out += fmt::format(

@@ -95,8 +95,6 @@ struct GroundTruthRun {
   // estimated (PoseGraphConfig::fix_correlation_s < 0 asks for that).
   double fix_correlation_s = 0;
   bool fix_correlation_estimated = false;
-  bool fix_error_states = false;  // the last solve's correlated fixes were Gauss-Markov states
-  double fix_white_fraction = 0;  // then the white share of a fix's variance
   std::vector<std::string> notes;
   double seconds = 0;
 };

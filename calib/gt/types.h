@@ -66,7 +66,8 @@ struct PoseGraphResult {
   // The fixes' correlation time the final solve used, s (the configuration's, or the most
   // likely one when PoseGraphConfig::fix_correlation_by_likelihood).
   double fix_correlation_s = 0;
-  double fix_white_fraction = 0;  // of a fix's variance, when its error is a state
+  // The white share of a fix's variance when its error was a state (> 0 then), else 0.
+  double fix_white_fraction = 0;
 };
 
 }  // namespace rigcal::gt
