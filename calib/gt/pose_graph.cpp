@@ -126,6 +126,7 @@ struct Graph {
   std::vector<PoseBlock> poses;
   // The fixes' error state at every scan (in units of the fixes' sigmas), when they are states.
   std::vector<Eigen::Vector3d> fix_errors;
+  std::vector<double> fix_error_a;  // each step's a (0 where the fixes' kind changes)
   ceres::Problem problem;
   std::vector<ceres::ResidualBlockId> prior_blocks;
 };
@@ -199,8 +200,9 @@ void build(Graph& g, const OdometryInput& odometry, const std::vector<Prior>& pr
     for (size_t k = 0; k + 1 < g.fix_errors.size(); ++k) {
       const double dt = (scans.stamps[k + 1] - scans.stamps[k]).seconds();
       const double tau = quality[k] == quality[k + 1] ? model.correlation_s : 0.0;
-      g.problem.AddResidualBlock(new ceres::AutoDiffCostFunction<FixErrorStepError, 3, 3, 3>(
-                                     new FixErrorStepError(dt, tau)),
+      auto* step = new FixErrorStepError(dt, tau);
+      g.fix_error_a.push_back(step->a);
+      g.problem.AddResidualBlock(new ceres::AutoDiffCostFunction<FixErrorStepError, 3, 3, 3>(step),
                                  nullptr, g.fix_errors[k].data(), g.fix_errors[k + 1].data());
     }
   }
@@ -551,11 +553,8 @@ PoseGraphResult solve_pose_graph(const OdometryInput& odometry,
       // step's I / (1 - a^2), a kept prior's (white C)^-1 (up to log det C, constant).
       if (!f.covariance.empty() && states) {
         f.minus_2_log_likelihood = 2.0 * summary.final_cost + log_det;
-        for (size_t k = 0; k + 1 < n; ++k) {
-          const double a =
-              FixErrorStepError((scans.stamps[k + 1] - scans.stamps[k]).seconds(), tau_s).a;
+        for (const double a : g.fix_error_a)
           f.minus_2_log_likelihood += 3.0 * std::log(std::max(1.0 - a * a, 1e-12));
-        }
         f.minus_2_log_likelihood += 3.0 * double(kept) * std::log(white_fraction);
       }
     }
