@@ -58,6 +58,8 @@ void add_rig_show(CLI::App& rig);
 void add_rig_convert(CLI::App& rig);
 // `rigcal bench`
 void add_bench(CLI::App& app);
+// `rigcal capture`
+void add_capture(CLI::App& app);
 // `rigcal simulate`
 void add_simulate(CLI::App& app);
 // `rigcal cameras`

@@ -41,6 +41,7 @@ int main(int argc, char** argv) {
   rigcal::cli::add_diff(app);
   rigcal::cli::add_report(app);
   rigcal::cli::add_convert(app);
+  rigcal::cli::add_capture(app);
   CLI::App* rig = app.add_subcommand("rig", "Check, show and convert a calibration YAML");
   rig->require_subcommand(1);
   rigcal::cli::add_rig_validate(*rig);

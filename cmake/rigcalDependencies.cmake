@@ -19,6 +19,10 @@ endif()
 if(NOT TARGET PkgConfig::PCAP)
   pkg_check_modules(PCAP REQUIRED IMPORTED_TARGET libpcap)
 endif()
+# GigE Vision and USB3 Vision cameras (calib/capture): Aravis 0.8, whose .pc requires libusb-1.0's.
+if(NOT TARGET PkgConfig::ARAVIS)
+  pkg_check_modules(ARAVIS REQUIRED IMPORTED_TARGET aravis-0.8)
+endif()
 find_dependency(TBB)
 find_dependency(apriltag)
 # The image reader decodes JPEG itself and checks PNG chunk CRCs (calib/io/image_io.cpp).

@@ -32,3 +32,13 @@ foreach(i RANGE 0 ${last} 2)
   list(GET rigcal_slow_tests ${j} cost)
   set_tests_properties(${name} PROPERTIES COST ${cost})
 endforeach()
+
+# The capture tests serve Aravis' GigE Vision simulator on 127.0.0.1:3956: one at a time.
+foreach(name CaptureSim.FeaturesAreSetAndReadBackAndTheMissingDefaultsReported
+             CaptureSim.ARequiredFeatureAbsentOrRefusedIsNamedAndNothingIsWritten
+             CaptureSim.SoftwareTriggeredFramesAreCountedAndEqualTheSimulatorsImages
+             CaptureSim.AnInterruptMidStreamLosesNothing
+             CaptureSim.ACameraLostMidStreamIsNamedAndWhatWasRecordedKept
+             CaptureSim.TwoCamerasRecordingCalibratesAsTheImagesItRecorded)
+  set_tests_properties(${name} PROPERTIES RESOURCE_LOCK gige_simulator)
+endforeach()
