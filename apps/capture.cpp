@@ -93,7 +93,11 @@ void run(const Options& o) {
   if (result.cameras.size() == 2) {
     fmt::print("pairs by trigger: {} (stamps within {:.2f} ms of each other)\n", result.pairs,
                1e3 * result.max_pair_difference_s);
-    if (result.max_pair_difference_s > 0.005)
+    if (result.pairs == 0)
+      fmt::print(
+          "note: no frame of one camera has a frame of the other within half a frame "
+          "interval: with stamps: camera, the cameras' clocks must be synchronised (PTP)\n");
+    else if (result.max_pair_difference_s > 0.005)
       fmt::print(
           "note: rigcal calibrate pairs the cameras' images within 5 ms: pairs further "
           "apart are left out (host stamps differ by the frames' transfer; cameras' own "

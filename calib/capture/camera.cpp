@@ -126,6 +126,7 @@ struct Camera::Impl {
   std::atomic<bool> lost{false};
   std::mutex control;        // the control channel: features and triggers from two threads
   std::string pixel_format;  // as the stream started
+  bool stopped = false;      // the acquisition
 
   static void on_control_lost(ArvDevice*, gpointer self) { static_cast<Impl*>(self)->lost = true; }
   ArvDevice* device() const { return arv_camera_get_device(camera); }
@@ -238,8 +239,16 @@ FeatureResult Camera::set(const std::vector<std::string>& alternatives, const st
       r.feature += (r.feature.empty() ? "" : " | ") + name;
     return r;
   }
+  std::string text = value;
+  if (ARV_IS_GC_BOOLEAN(node)) {
+    // Aravis takes "true" alone as true: anything else, "True" or "1", would set false.
+    std::string lower;
+    for (char ch : value) lower += static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    if (lower == "true" || lower == "yes" || lower == "on" || lower == "1") text = "true";
+    if (lower == "false" || lower == "no" || lower == "off" || lower == "0") text = "false";
+  }
   GError* error = nullptr;
-  arv_gc_feature_node_set_value_from_string(node, value.c_str(), &error);
+  arv_gc_feature_node_set_value_from_string(node, text.c_str(), &error);
   const std::string refused = take_error(error);
   const char* back = arv_gc_feature_node_get_value_as_string(node, &error);
   take_error(error);
@@ -255,7 +264,7 @@ FeatureResult Camera::set(const std::vector<std::string>& alternatives, const st
     r.status = std::abs(*a - *b) <= tolerance ? FeatureResult::Status::set
                                               : FeatureResult::Status::adjusted;
   } else {
-    r.status = r.accepted == value ? FeatureResult::Status::set : FeatureResult::Status::refused;
+    r.status = r.accepted == text ? FeatureResult::Status::set : FeatureResult::Status::refused;
   }
   return r;
 }
@@ -294,6 +303,7 @@ void Camera::start(int buffers) {
     why = take_error(error);
   }
   if (!why.empty()) throw Error(fmt::format("{}: acquisition not started: {}", impl_->name(), why));
+  impl_->stopped = false;
 }
 
 StreamEvent Camera::next(double timeout_s) {
@@ -347,21 +357,25 @@ StreamEvent Camera::next(double timeout_s) {
   return e;
 }
 
-void Camera::software_trigger() {
+bool Camera::software_trigger() {
   std::lock_guard lock(impl_->control);
   GError* error = nullptr;
   arv_camera_software_trigger(impl_->camera, &error);
+  return take_error(error).empty();
+}
+
+void Camera::stop_acquisition() {
+  if (!impl_ || !impl_->stream || impl_->stopped) return;
+  std::lock_guard lock(impl_->control);
+  GError* error = nullptr;
+  if (!impl_->lost) arv_camera_stop_acquisition(impl_->camera, &error);
   take_error(error);
+  impl_->stopped = true;
 }
 
 void Camera::stop() {
   if (!impl_ || !impl_->stream) return;
-  {
-    std::lock_guard lock(impl_->control);
-    GError* error = nullptr;
-    if (!impl_->lost) arv_camera_stop_acquisition(impl_->camera, &error);
-    take_error(error);
-  }
+  stop_acquisition();
   g_object_unref(impl_->stream);
   impl_->stream = nullptr;
 }

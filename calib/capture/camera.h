@@ -69,6 +69,7 @@ class Camera {
   bool has(const std::string& feature) const;
   // The feature's value as text, nullopt when absent or unreadable.
   std::optional<std::string> get(const std::string& feature) const;
+  // Booleans are given as true/false, yes/no, on/off or 1/0 (any case).
   // Sets the first of `alternatives` the camera has (GenICam names differ between standard
   // versions: ExposureTime and ExposureTimeAbs) to `value` and reads it back: set, adjusted (a
   // number the camera rounded by more than 0.1 %), refused (an error, or text read back other
@@ -84,8 +85,12 @@ class Camera {
   void start(int buffers);
   // The next buffer within `timeout_s`. Thread-safe against software_trigger() from another thread.
   StreamEvent next(double timeout_s);
-  void software_trigger();
-  // Stops acquisition (errors ignored: the camera may be gone) and releases the stream.
+  // False when the camera refused it.
+  bool software_trigger();
+  // Stops the acquisition (errors ignored: the camera may be gone); next() still gives the
+  // buffers received before.
+  void stop_acquisition();
+  // Stops the acquisition and releases the stream.
   void stop();
   // True once Aravis reported the control connection lost (the camera gone or unplugged).
   bool lost() const;

@@ -79,27 +79,23 @@ struct Recorder {
   std::atomic<size_t> received{0};  // frames and damaged buffers
   std::atomic<size_t> written{0};
   std::atomic<uint64_t> missing{0};
-  std::mutex record_mutex;          // record's lists, between the receiver and the report
+  std::mutex record_mutex;  // record's lists, between the receiver and the report
+  std::atomic<size_t> trigger_failures{0};
+  Assistant* assistant = nullptr;
+  size_t index = 0;
   std::optional<uint64_t> last_id;  // the receiver's
   size_t queued = 0;                // the receiver's: frames handed to the writer
 };
 
-// The ids between the last one seen and `id` (GigE Vision ids are 16 bits and skip 0).
 void account_id(Recorder& r, uint64_t id) {
   if (r.last_id) {
-    const uint64_t modulus = r.gige ? 65535 : 0;
-    uint64_t step = 0;
-    if (modulus) {
-      const uint64_t prev = (*r.last_id - 1) % modulus, now = (id + modulus - 1) % modulus;
-      step = (now + modulus - prev) % modulus;
-    } else {
-      step = id > *r.last_id ? id - *r.last_id : 0;
-    }
-    if (step > 1) {
-      std::lock_guard lock(r.record_mutex);
-      const uint64_t first = r.gige ? (*r.last_id % 65535) + 1 : *r.last_id + 1;
-      r.record.gaps.push_back({static_cast<long>(r.queued) - 1, first, step - 1});
-      r.missing += step - 1;
+    const IdStep step = id_step(*r.last_id, id, r.gige);
+    std::lock_guard lock(r.record_mutex);
+    if (step.missing > 0) {
+      r.record.gaps.push_back({static_cast<long>(r.queued) - 1, step.first_missing, step.missing});
+      r.missing += step.missing;
+    } else if (step.backwards) {
+      r.record.id_restarts.push_back(fmt::format("{} after {}", id, *r.last_id));
     }
   }
   r.last_id = id;
@@ -119,6 +115,7 @@ void receive(Recorder& r, const std::atomic<bool>& stop, std::atomic<bool>& fail
       return true;
     }
     account_id(r, e.frame.frame_id);
+    if (r.assistant) r.assistant->offer(r.index, e.frame.image, e.frame.host_stamp);
     ++r.queued;
     r.queue.push(std::move(e.frame));
     return true;
@@ -133,8 +130,12 @@ void receive(Recorder& r, const std::atomic<bool>& stop, std::atomic<bool>& fail
       break;
     }
   }
-  // What arrived before the stop is kept: the buffers already filled, then the acquisition ends.
-  while (handle(r.camera->next(0.0))) {
+  // What arrived before the stop is kept: the acquisition ends, then the buffers filled and those
+  // still in transfer (until none for a quarter of a second, a second at most: a camera that
+  // ignores the stop, as Aravis' fake interface's, would stream on) are taken.
+  r.camera->stop_acquisition();
+  const auto drain_end = Clock::now() + std::chrono::seconds(1);
+  while (Clock::now() < drain_end && handle(r.camera->next(0.25))) {
   }
   r.camera->stop();
   r.queue.close();
@@ -153,15 +154,34 @@ void write_frames(Recorder& r, const std::filesystem::path& folder, io::CaptureS
   while (r.queue.pop(f)) {
     const size_t index = r.written.load();
     const std::string name = fmt::format("{:010d}", index);
-    const std::filesystem::path part = data / (name + ".part.png"), final = data / (name + ".png");
+    // Written under a name the session reader does not take (*.png), renamed once whole.
+    const std::filesystem::path part = data / (name + ".tmp"), final = data / (name + ".png");
     bool ok = false;
     try {
-      ok = cv::imwrite(part.string(), f.image, {cv::IMWRITE_PNG_COMPRESSION, 1});
+      std::vector<uint8_t> png;
+      ok = cv::imencode(".png", f.image, png, {cv::IMWRITE_PNG_COMPRESSION, 1});
+      if (ok) {
+        std::ofstream out(part, std::ios::binary);
+        out.write(reinterpret_cast<const char*>(png.data()),
+                  static_cast<std::streamsize>(png.size()));
+        out.close();
+        ok = out.good();
+      }
       if (ok) std::filesystem::rename(part, final);
     } catch (const std::exception&) {
       ok = false;
     }
     const Time t = source == io::CaptureStamps::host ? f.host_stamp : f.device_stamp;
+    if (ok && !r.record.stamps.empty() && t <= r.record.stamps.back()) {
+      std::lock_guard lock(r.record_mutex);
+      if (r.record.error.empty())
+        r.record.error = fmt::format(
+            "{}: the stamp of {} ({}) is not after the previous one: the {} clock went back "
+            "(the host's clock stepped, or the camera restarted its own); the frames are kept, "
+            "but the session reader refuses stamps that do not increase",
+            r.record.folder, final.filename().string(), to_iso8601(t), io::to_string(source));
+      failed = true;
+    }
     if (ok) {
       stamps << to_iso8601(t) << '\n';
       frames << name << ".png," << f.frame_id << ',' << f.device_stamp.ns << ',' << f.host_stamp.ns
@@ -173,6 +193,7 @@ void write_frames(Recorder& r, const std::filesystem::path& folder, io::CaptureS
     if (!ok) {
       std::error_code ec;
       std::filesystem::remove(part, ec);
+      std::filesystem::remove(final, ec);  // a file without its stamp would break the folder
       std::lock_guard lock(r.record_mutex);
       if (r.record.error.empty())
         r.record.error = fmt::format(
@@ -203,7 +224,44 @@ double median_interval_s(const std::vector<Time>& stamps) {
   return d[d.size() / 2];
 }
 
+// Mono or raw Bayer, 8 bits or unpacked in 16 (what camera.cpp writes as it comes).
+bool recordable_pixel_format(const std::string& f) {
+  std::string bits;
+  if (f.rfind("Mono", 0) == 0)
+    bits = f.substr(4);
+  else if (f.rfind("Bayer", 0) == 0 && f.size() > 7)
+    bits = f.substr(7);
+  else
+    return false;
+  return bits == "8" || bits == "10" || bits == "12" || bits == "14" || bits == "16";
+}
+
 }  // namespace
+
+IdStep id_step(uint64_t previous, uint64_t id, bool gige16) {
+  IdStep s;
+  if (gige16) {
+    // 1..65535, 0 never used: positions 0..65534 on a circle. A step back of under half the
+    // circle is the camera restarting its count, not 65,000 frames lost.
+    constexpr uint64_t n = 65535;
+    const uint64_t a = (previous + n - 1) % n, b = (id + n - 1) % n;
+    const uint64_t forward = (b + n - a) % n;
+    if (forward == 0 || forward > n / 2) {
+      s.backwards = true;
+      return s;
+    }
+    s.missing = forward - 1;
+    s.first_missing = previous % n + 1;
+  } else {
+    if (id <= previous) {
+      s.backwards = true;
+      return s;
+    }
+    s.missing = id - previous - 1;
+    s.first_missing = previous + 1;
+  }
+  return s;
+}
 
 std::string bayer_pattern(const std::string& pixel_format) {
   if (pixel_format.rfind("Bayer", 0) != 0 || pixel_format.size() < 7) return "";
@@ -278,6 +336,11 @@ std::vector<FeatureResult> configure(Camera& camera, const io::CaptureCameraConf
     }
   }
   const std::string format = camera.get("PixelFormat").value_or(c.pixel_format);
+  if (!recordable_pixel_format(format))
+    throw Error(fmt::format(
+        "{} ({}): pixel format {} is not recorded (packed, colour or YUV): give pixel_format one "
+        "of Mono8/10/12/14/16 or Bayer..8/10/12/14/16 the camera has ({})",
+        c.folder, describe(camera.info()), format, fmt::join(camera.info().pixel_formats, " ")));
   if (c.balance_white_given || is_colour_mosaic(format))
     set({"BalanceWhiteAuto"}, c.balance_white == "auto" ? "Continuous" : "Off",
         c.balance_white_given,
@@ -346,15 +409,54 @@ CaptureRun record(const RecordOptions& o) {
   }
   io::FolderLock lock(o.out);
   for (const auto& r : recorders) fs::create_directories(o.out / r->record.folder / "data");
+  std::unique_ptr<Assistant> assistant;
+  if (o.assist) {
+    AssistOptions a = *o.assist;
+    if (a.png.empty()) a.png = o.out / "coverage.png";
+    if (a.bayer == io::Bayer::none) {
+      const std::string pattern = bayer_pattern(recorders.front()->record.pixel_format);
+      if (!pattern.empty()) a.bayer = io::bayer_from_string(pattern);
+    }
+    std::vector<std::string> folders;
+    for (const auto& r : recorders) folders.push_back(r->record.folder);
+    assistant = std::make_unique<Assistant>(a, folders);
+    for (size_t i = 0; i < recorders.size(); ++i) {
+      recorders[i]->assistant = assistant.get();
+      recorders[i]->index = i;
+    }
+  }
 
   std::atomic<bool> stop{false}, failed{false};
-  for (auto& c : cameras) c->start(o.config.buffers);
+  try {
+    for (auto& c : cameras) c->start(o.config.buffers);
+  } catch (...) {
+    for (auto& c : cameras) c->stop();
+    // Nothing was recorded: the folders made for it go, so the same command can run again.
+    std::error_code ec;
+    for (const auto& r : recorders) fs::remove_all(o.out / r->record.folder, ec);
+    throw;
+  }
   const auto start = Clock::now();
   std::vector<std::thread> threads;
   for (auto& r : recorders) {
-    threads.emplace_back([&r, &stop, &failed] { receive(*r, stop, failed); });
-    threads.emplace_back(
-        [&r, &o, &failed] { write_frames(*r, o.out / r->record.folder, o.config.stamps, failed); });
+    // A thread that throws (out of memory) ends its camera's recording with the reason.
+    auto guarded = [&r, &failed](auto body) {
+      return [&r, &failed, body] {
+        try {
+          body();
+        } catch (const std::exception& e) {
+          std::lock_guard lock(r->record_mutex);
+          if (r->record.error.empty())
+            r->record.error = fmt::format("{}: recording stopped: {}", r->record.folder, e.what());
+          failed = true;
+          r->queue.close();
+        }
+      };
+    };
+    threads.emplace_back(guarded([&r, &stop, &failed] { receive(*r, stop, failed); }));
+    threads.emplace_back(guarded([&r, &o, &failed] {
+      write_frames(*r, o.out / r->record.folder, o.config.stamps, failed);
+    }));
   }
   // Software triggers: every software-triggered camera at once, at the configured rate.
   std::thread trigger;
@@ -366,79 +468,100 @@ CaptureRun record(const RecordOptions& o) {
       // up to half a second later and makes one frame of the triggers sent before. The first
       // trigger half a second after the start.
       auto next = Clock::now() + std::chrono::milliseconds(500);
-      std::this_thread::sleep_until(next);
+      auto sleep_until = [&](Clock::time_point t) {
+        while (!stop && Clock::now() < t)
+          std::this_thread::sleep_for(
+              std::min<Clock::duration>(t - Clock::now(), std::chrono::milliseconds(10)));
+      };
+      sleep_until(next);
       while (!stop && (!o.frames || triggers < *o.frames)) {
         for (auto& r : recorders)
-          if (r->record.trigger == "Software") r->camera->software_trigger();
+          if (r->record.trigger == "Software" && !r->camera->software_trigger())
+            ++r->trigger_failures;
         ++triggers;
         next += std::chrono::duration_cast<Clock::duration>(period);
-        std::this_thread::sleep_until(next);
+        sleep_until(next);
       }
     });
 
   auto last_progress = start;
   size_t settled_at_count = 0;
   auto settled_since = start;
-  while (true) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    const auto now = Clock::now();
-    const double elapsed = std::chrono::duration<double>(now - start).count();
-    if (failed) {
-      run.stopped_by = "error";
-      break;
-    }
-    if (o.interrupt && *o.interrupt) {
-      run.stopped_by = "interrupt";
-      break;
-    }
-    if (o.duration_s && elapsed >= *o.duration_s) {
-      run.stopped_by = "duration";
-      break;
-    }
-    if (o.frames) {
-      bool all = true;
-      size_t total = 0;
-      for (auto& r : recorders) {
-        all = all && r->received >= *o.frames;
-        total += r->received;
-      }
-      if (all) {
-        run.stopped_by = "frames";
+  // Whatever the loop throws (a progress callback's broken terminal), the threads stop and join
+  // first and what was received is written.
+  std::exception_ptr thrown;
+  try {
+    while (true) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      const auto now = Clock::now();
+      const double elapsed = std::chrono::duration<double>(now - start).count();
+      if (failed) {
+        run.stopped_by = "error";
         break;
       }
-      // Every software trigger sent and nothing more arriving for a second: the frames the
-      // cameras dropped will not come.
-      if (software_rate > 0 && triggers >= *o.frames) {
-        if (total != settled_at_count) {
-          settled_at_count = total;
-          settled_since = now;
-        } else if (now - settled_since > std::chrono::seconds(1)) {
+      if (o.interrupt && *o.interrupt) {
+        run.stopped_by = "interrupt";
+        break;
+      }
+      if (o.duration_s && elapsed >= *o.duration_s) {
+        run.stopped_by = "duration";
+        break;
+      }
+      if (o.frames) {
+        bool all = true;
+        size_t total = 0;
+        for (auto& r : recorders) {
+          all = all && r->written >= *o.frames;
+          total += r->received;
+        }
+        if (all) {
           run.stopped_by = "frames";
           break;
         }
+        // Every software trigger sent and nothing more arriving for a second: the frames the
+        // cameras dropped will not come.
+        if (software_rate > 0 && triggers >= *o.frames) {
+          if (total != settled_at_count) {
+            settled_at_count = total;
+            settled_since = now;
+          } else if (now - settled_since > std::chrono::seconds(1)) {
+            run.stopped_by = "frames";
+            break;
+          }
+        }
+      }
+      if (now - last_progress >= std::chrono::seconds(1)) {
+        last_progress = now;
+        if (assistant && o.on_coverage) o.on_coverage(assistant->coverage());
+        RecordProgress p;
+        p.seconds = elapsed;
+        for (auto& r : recorders) {
+          p.written.push_back(r->written);
+          p.missing.push_back(r->missing);
+        }
+        if (o.progress) o.progress(p);
       }
     }
-    if (o.progress && now - last_progress >= std::chrono::seconds(1)) {
-      last_progress = now;
-      RecordProgress p;
-      p.seconds = elapsed;
-      for (auto& r : recorders) {
-        p.written.push_back(r->written);
-        p.missing.push_back(r->missing);
-      }
-      o.progress(p);
-    }
+  } catch (...) {
+    thrown = std::current_exception();
+    run.stopped_by = "error";
   }
   stop = true;
   if (trigger.joinable()) trigger.join();
   for (std::thread& t : threads) t.join();
   run.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  if (assistant) run.coverage = assistant->coverage();
+  assistant.reset();
+  if (thrown) std::rethrow_exception(thrown);
 
   for (auto& r : recorders) {
     r->record.written = r->written;
     r->record.missing = r->missing;
     r->record.max_queue = r->queue.max_size;
-    if (r->record.trigger == "Software") r->record.triggers_sent = triggers;
+    if (r->record.trigger == "Software") {
+      r->record.triggers_sent = triggers - r->trigger_failures;
+      r->record.trigger_failures = r->trigger_failures;
+    }
     if (!r->record.error.empty() && run.error.empty()) run.error = r->record.error;
     run.cameras.push_back(std::move(r->record));
   }
@@ -504,6 +627,23 @@ nlohmann::json capture_report(const CaptureRun& run) {
          {"max_frames_waiting", c.max_queue},
          {"error", c.error}});
   }
+  json coverage = json::array();
+  for (const CameraCoverage& c : run.coverage)
+    coverage.push_back({{"folder", c.folder},
+                        {"frames_looked_at", c.looked_at},
+                        {"views", c.views},
+                        {"image_covered", c.covered},
+                        {"empty_zones", c.empty_zones},
+                        {"solved", c.solved},
+                        {"focal_px", c.focal_px},
+                        {"focal_relative_sigma", c.focal_rel_sigma},
+                        {"principal_point_sigma_px", c.principal_sigma_px},
+                        {"tilt_about_x_deg", {c.tilt_x_min_deg, c.tilt_x_max_deg}},
+                        {"tilt_about_y_deg", {c.tilt_y_min_deg, c.tilt_y_max_deg}},
+                        {"distance_m", {c.distance_min_m, c.distance_max_m}},
+                        {"worst_projection_sigma_px", c.worst_projection_sigma_px},
+                        {"worst_projection_at_px", {c.worst_at.x, c.worst_at.y}},
+                        {"missing", c.missing}});
   return {{"tool", "rigcal capture"},
           {"version", version_string()},
           {"stamps", std::string(io::to_string(run.config.stamps))},
@@ -517,7 +657,8 @@ nlohmann::json capture_report(const CaptureRun& run) {
           {"error", run.error},
           {"cameras", cameras},
           {"pairs", run.pairs},
-          {"max_pair_stamp_difference_s", run.max_pair_difference_s}};
+          {"max_pair_stamp_difference_s", run.max_pair_difference_s},
+          {"assistance", coverage}};
 }
 
 }  // namespace rigcal::capture

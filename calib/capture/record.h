@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "rigcal/capture/assist.h"
 #include "rigcal/capture/camera.h"
 #include "rigcal/io/capture_config.h"
 
@@ -31,6 +32,15 @@ struct FrameGap {
   uint64_t count = 0;
 };
 
+// What a frame id says after the previous one: how many ids were skipped (the frames missing),
+// from which, or that it went back (the camera restarted its count). GigE Vision ids (gige16) are
+// 16 bits: 1..65535, 0 never used, 65535 followed by 1.
+struct IdStep {
+  uint64_t missing = 0, first_missing = 0;
+  bool backwards = false;
+};
+IdStep id_step(uint64_t previous, uint64_t id, bool gige16);
+
 struct CameraRecord {
   std::string folder;
   CameraInfo info;
@@ -41,9 +51,11 @@ struct CameraRecord {
   std::vector<std::string> incomplete_statuses;  // "frame id: status", the first 100
   uint64_t missing = 0;                          // frame ids never received (gaps)
   std::vector<FrameGap> gaps;
-  size_t triggers_sent = 0;       // software triggers
-  std::vector<Time> stamps;       // of the files written, the chosen clock
-  std::vector<Time> host_stamps;  // of the files written
+  size_t triggers_sent = 0;              // software triggers the camera took
+  size_t trigger_failures = 0;           // software triggers it refused
+  std::vector<std::string> id_restarts;  // ids that went back ("12 after 4071")
+  std::vector<Time> stamps;              // of the files written, the chosen clock
+  std::vector<Time> host_stamps;         // of the files written
   double receive_cpu_s = 0, write_cpu_s = 0;
   size_t max_queue = 0;  // frames waiting for the writer at most
   std::string error;     // the camera lost, a write failed
@@ -58,7 +70,8 @@ struct CaptureRun {
   std::string error;       // "" when the recording ended as asked
   // Two cameras: the frames paired by trigger (nearest stamps within half the frame interval).
   size_t pairs = 0;
-  double max_pair_difference_s = 0;  // of the pairs' stamps
+  double max_pair_difference_s = 0;      // of the pairs' stamps
+  std::vector<CameraCoverage> coverage;  // with assistance: what the views covered at the end
 };
 
 struct RecordProgress {
@@ -74,6 +87,11 @@ struct RecordOptions {
   std::optional<double> duration_s;                     // stop after this long
   const std::atomic<bool>* interrupt = nullptr;         // set by the caller (Ctrl-C): stop cleanly
   std::function<void(const RecordProgress&)> progress;  // about once a second
+  // Calibration assistance (assist.h) on the recorded frames; its PNG is written as
+  // OUT/coverage.png unless `assist->png` says otherwise. Its raw Bayer pattern, when none is
+  // given, is the first camera's pixel format's.
+  std::optional<AssistOptions> assist;
+  std::function<void(const std::vector<CameraCoverage>&)> on_coverage;  // about once a second
   // Called with each camera once it is configured, before streaming (the tests attach their
   // simulators' images through it).
   std::function<void(const io::CaptureCameraConfig&, Camera&)> on_configured;

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include <cctype>
 #include <cmath>
 #include <set>
 
@@ -35,6 +36,13 @@ double number(const YAML::Node& n, std::string_view file, const std::string& key
   return x;
 }
 
+int whole(const YAML::Node& n, std::string_view file, const std::string& key, int low, int high) {
+  const double x = number(n, file, key, low, high);
+  if (x != std::floor(x))
+    fail_at(file, yaml_line(n), key, fmt::format("expected a whole number, got '{}'", n.Scalar()));
+  return static_cast<int>(x);
+}
+
 CaptureCameraConfig parse_camera(const std::string& folder, const YAML::Node& node,
                                  std::string_view file) {
   const std::string at = "cameras." + folder;
@@ -54,8 +62,7 @@ CaptureCameraConfig parse_camera(const std::string& folder, const YAML::Node& no
       if (!v.IsSequence() || v.size() != 4)
         fail_at(file, yaml_line(v), k, "expected [x, y, width, height] in pixels");
       std::array<int, 4> r{};
-      for (size_t i = 0; i < 4; ++i)
-        r[i] = static_cast<int>(number(v[i], file, k, i < 2 ? 0 : 1, 65535));
+      for (size_t i = 0; i < 4; ++i) r[i] = whole(v[i], file, k, i < 2 ? 0 : 1, 65535);
       c.region = r;
     } else if (key == "trigger") {
       c.trigger = scalar(v, file, k);
@@ -98,6 +105,16 @@ CaptureCameraConfig parse_camera(const std::string& folder, const YAML::Node& no
   if (c.id.empty())
     fail_at(file, yaml_line(node), at,
             "expected an id (what Aravis opens: device id, serial or address)");
+  const bool hardware = c.trigger != "off" && c.trigger != "Software";
+  if (hardware && c.frame_rate_given)
+    fail_at(
+        file, yaml_line(node), at,
+        fmt::format("frame_rate_hz sets a free-running or software-triggered rate: with trigger "
+                    "{} the rate is the trigger's",
+                    c.trigger));
+  if (!hardware && c.trigger_activation)
+    fail_at(file, yaml_line(node), at,
+            "trigger_activation applies to a hardware trigger line, not to Software or off");
   if (c.exposure_us && c.exposure_auto_max_given)
     fail_at(file, yaml_line(node), at,
             "exposure_auto_max_us caps the automatic exposure: give it with exposure_us: auto");
@@ -128,7 +145,7 @@ CaptureConfig parse_capture_config(std::string_view text, std::string_view file)
       else
         fail_at(file, yaml_line(v), key, fmt::format("expected host or camera, got '{}'", s));
     } else if (key == "buffers") {
-      config.buffers = static_cast<int>(number(v, file, key, 2, 1000));
+      config.buffers = whole(v, file, key, 2, 1000);
     } else if (key == "cameras") {
       have_cameras = true;
       if (!v.IsMap() || v.size() == 0)

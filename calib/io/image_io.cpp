@@ -283,6 +283,11 @@ cv::Mat read_gray(const std::filesystem::path& path, Bayer bayer) {
   }
   if (img.empty()) throw Error(fmt::format("{}: cannot read the image", name));
   if (!header.sized) check_image_size({header.format, img.cols, img.rows, true}, name);
+  return to_gray(img, bayer, name);
+}
+
+cv::Mat to_gray(const cv::Mat& image, Bayer bayer, std::string_view name) {
+  cv::Mat img = image;
   if (img.depth() == CV_16U) img.convertTo(img, CV_8U, 1.0 / 256);
   if (img.depth() != CV_8U) throw Error(fmt::format("{}: expected an 8- or 16-bit image", name));
   cv::Mat gray;  // never img's buffer: demosaicing in place reads pixels it has overwritten

@@ -30,5 +30,7 @@ inline bool within_image_limits(long long width, long long height) {
 // the sizes above, or when a Bayer pattern is given for a colour image. libpng and libjpeg print
 // nothing; OpenCV's warnings follow its log level (the CLI keeps errors only).
 cv::Mat read_gray(const std::filesystem::path& path, Bayer bayer = Bayer::none);
+// The same conversion of an image in memory (a camera's frame); `name` names it in errors.
+cv::Mat to_gray(const cv::Mat& image, Bayer bayer, std::string_view name);
 
 }  // namespace rigcal::io
