@@ -10,13 +10,14 @@
 #include "rigcal/capture/record.h"
 #include "rigcal/core/error.h"
 #include "rigcal/io/capture_config.h"
+#include "rigcal/io/target_yaml.h"
 
 namespace rigcal::cli {
 namespace capture_command {
 
 struct Options {
   bool list = false, fake = false;
-  std::string config, left, right, out;
+  std::string config, left, right, out, target, bayer;
   size_t frames = 0;
   double duration_s = 0;
 };
@@ -72,6 +73,20 @@ void run(const Options& o) {
                           p.missing[i] ? fmt::format(" ({} missing)", p.missing[i]) : "");
     fmt::print(stderr, "{}   ", line);
   };
+  if (!o.target.empty()) {
+    capture::AssistOptions assist;
+    assist.target = io::read_target_file(o.target);
+    assist.bayer = io::bayer_from_string(o.bayer);
+    options.assist = assist;
+    auto last = std::make_shared<std::vector<std::string>>();
+    options.on_coverage = [last](const std::vector<capture::CameraCoverage>& coverage) {
+      const auto lines = capture::Assistant::lines(coverage);
+      if (lines == *last) return;
+      *last = lines;
+      for (const std::string& line : lines) fmt::print(stderr, "\n{}", line);
+      fmt::print(stderr, "\n");
+    };
+  }
   std::signal(SIGINT, on_interrupt);
   const capture::CaptureRun result = capture::record(options);
   std::signal(SIGINT, SIG_DFL);
@@ -107,6 +122,9 @@ void run(const Options& o) {
              result.stopped_by, result.seconds, o.out, o.out);
   const std::string bayer =
       result.cameras.empty() ? "" : capture::bayer_pattern(result.cameras[0].pixel_format);
+  for (const std::string& line : capture::Assistant::lines(result.coverage))
+    fmt::print("{}\n", line);
+  if (!result.coverage.empty()) fmt::print("the views' coverage: {}/coverage.png\n", o.out);
   if (!bayer.empty())
     fmt::print("raw {} mosaics: calibrate with `rigcal calibrate --session {} --bayer {} ...`\n",
                result.cameras[0].pixel_format, o.out, bayer);
@@ -138,6 +156,13 @@ void add_capture(CLI::App& app) {
       ->check(whole_count("a number of frames"));
   cmd->add_option("--duration", o->duration_s, "stop after this many seconds")
       ->check(seconds_within(0.001));
+  cmd->add_option("--target", o->target,
+                  "calibration assistance with this board (target YAML): the detector on a "
+                  "decimated stream says which parts of the image, tilts and distances are "
+                  "missing for the camera step's bars, refreshes OUT/coverage.png")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--bayer", o->bayer,
+                  "the raw mosaic for the assistance's detector (default: from the pixel format)");
   cmd->add_flag("--fake", o->fake, "also see Aravis' in-process fake camera, Fake_1 (for trying)");
   cmd->callback([o] { run(*o); });
 }

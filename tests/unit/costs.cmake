@@ -35,6 +35,7 @@ endforeach()
 
 # The capture tests serve Aravis' GigE Vision simulator on 127.0.0.1:3956: one at a time.
 foreach(name CaptureSim.FeaturesAreSetAndReadBackAndTheMissingDefaultsReported
+             CaptureSim.TheCommandRecordsAndRefusesBadInputWithExitTwo
              CaptureSim.ARequiredFeatureAbsentOrRefusedIsNamedAndNothingIsWritten
              CaptureSim.SoftwareTriggeredFramesAreCountedAndEqualTheSimulatorsImages
              CaptureSim.AnInterruptMidStreamLosesNothing

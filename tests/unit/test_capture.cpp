@@ -145,6 +145,30 @@ TEST(CaptureConfig, ReadsTheCamerasAndNamesWhatIsWrong) {
             "off");
 }
 
+// The command: a recording from Aravis' in-process fake camera, and bad input as exit 2 with one
+// line naming it.
+TEST_F(CaptureSim, TheCommandRecordsAndRefusesBadInputWithExitTwo) {
+  const fs::path out = dir_ / "rec";
+  const testing::CliRun r = testing::rigcal_cli(
+      "capture --fake --left Fake_1 --out " + out.string() + " --frames 5", dir_);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("camera_left: Fake_1 (Aravis Fake"), std::string::npos) << r.out;
+  EXPECT_GE(io::read_stamped_folder(out / "camera_left", ".png").files.size(), 5u);
+  const testing::CliRun again = testing::rigcal_cli(
+      "capture --fake --left Fake_1 --out " + out.string() + " --frames 5", dir_);
+  EXPECT_EQ(again.status, 2);
+  EXPECT_NE(again.err.find("exists and is not an empty folder (a recording is never written over)"),
+            std::string::npos)
+      << again.err;
+  const fs::path bad = write("c.yaml", "cameras:\n  camera_left: {id: a, exposure: 3}\n");
+  const testing::CliRun config = testing::rigcal_cli(
+      "capture --config " + bad.string() + " --out " + (dir_ / "other").string(), dir_);
+  EXPECT_EQ(config.status, 2);
+  EXPECT_NE(config.err.find("key 'cameras.camera_left.exposure': unknown key"), std::string::npos)
+      << config.err;
+  EXPECT_FALSE(fs::exists(dir_ / "other"));
+}
+
 // Frame ids: GigE Vision's 16 bits (1..65535, 0 never used) and the 64 bits of other cameras.
 TEST(CaptureIds, GapsAcrossTheWrapAndRestartsAreTold) {
   struct Case {
