@@ -23,7 +23,9 @@ set(rigcal_slow_tests
     Cli.LidarCameraWritesTheRigAndRefusesTooFewBoards 13
     RealReport.OpenCvStereoSamples 12
     SequenceBa.AWalksWindowsGiveMotionsBetterThanTheOdometrysWithHonestSigmas 11
-    Steps.CamerasWritesBothCamerasAndReusesItsDetections 10)
+    Steps.CamerasWritesBothCamerasAndReusesItsDetections 10
+    CaptureSim.TwoCamerasRecordingCalibratesAsTheImagesItRecorded 25
+    CaptureSim.ACameraLostMidStreamIsNamedAndWhatWasRecordedKept 17)
 list(LENGTH rigcal_slow_tests n)
 math(EXPR last "${n} - 1")
 foreach(i RANGE 0 ${last} 2)

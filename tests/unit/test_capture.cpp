@@ -432,7 +432,16 @@ TEST_F(CaptureSim, TwoCamerasRecordingCalibratesAsTheImagesItRecorded) {
     o.config.cameras.push_back(c);
   }
   o.out = dir_ / "rec";
-  o.frames = 24;
+  // Recorded until the assistance has kept six views of each camera and solved them (the
+  // detector looks at fewer frames on a loaded machine), a minute and a half at most.
+  std::atomic<bool> enough{false};
+  o.interrupt = &enough;
+  o.duration_s = 90;
+  o.on_coverage = [&](const std::vector<capture::CameraCoverage>& coverage) {
+    bool all = coverage.size() == 2;
+    for (const auto& c : coverage) all = all && c.views >= 6 && c.solved;
+    if (all) enough = true;
+  };
   capture::AssistOptions assist;
   assist.target = io::read_target_file(RIGCAL_SOURCE_DIR "/targets/a3_checkerboard_8x5_40mm.yaml");
   assist.every_s = 0;  // every frame the detector is free for
@@ -447,7 +456,7 @@ TEST_F(CaptureSim, TwoCamerasRecordingCalibratesAsTheImagesItRecorded) {
   for (int k = 0; k < 2; ++k) {
     const capture::CameraRecord& c = run.cameras.at(k);
     EXPECT_EQ(c.pixel_format, "BayerRG8");
-    EXPECT_GE(c.written, 24u);
+    EXPECT_GE(c.written, 20u);
     EXPECT_EQ(c.missing, 0u);
     // Every image is the view of its slot, bit for bit, through the GigE Vision stack.
     const auto rows = lines_of(o.out / folders[k] / "frames.csv");
@@ -468,45 +477,48 @@ TEST_F(CaptureSim, TwoCamerasRecordingCalibratesAsTheImagesItRecorded) {
   for (int k = 0; k < 2; ++k) {
     const capture::CameraCoverage& c = run.coverage[k];
     EXPECT_GE(c.views, 6u) << folders[k];
-    EXPECT_TRUE(c.solved) << folders[k];
-    EXPECT_GT(c.covered, 0.3) << folders[k];
-    EXPECT_NEAR(c.focal_px, rig::sensor(truth, k == 0 ? "cam_l" : "cam_r").camera.fx, 5)
+    ASSERT_TRUE(c.solved) << folders[k];
+    EXPECT_GT(c.covered, 0.2) << folders[k];
+    // Its focal length within 3 of its own sigmas of the truth.
+    EXPECT_LT(std::abs(c.focal_px - rig::sensor(truth, k == 0 ? "cam_l" : "cam_r").camera.fx),
+              3 * c.focal_rel_sigma * c.focal_px)
         << folders[k];
     EXPECT_FALSE(c.missing.empty()) << "8 views do not meet the camera step's bars at 3 sigma";
   }
   EXPECT_FALSE(cv::imread((o.out / "coverage.png").string()).empty());
   // The fake interface's camera runs late by up to tens of milliseconds (it sleeps a period after
   // drawing): its frames still pair with the left's by the slot, all but the first.
-  EXPECT_GE(run.pairs, 23u);
+  EXPECT_EQ(run.stopped_by, "interrupt") << "the assistance had six views of each";
+  EXPECT_GE(run.pairs + 1, std::min(run.cameras[0].written, run.cameras[1].written));
 
+  // `rigcal calibrate` on the recording as it is (its cameras step: the recording has no LiDAR),
+  // against the same on the images the simulator wrote.
   auto calibrate = [&](const fs::path& session, const std::string& name) {
     const testing::CliRun r = testing::rigcal_cli(
-        "cameras --session " + session.string() +
-            " --target " RIGCAL_SOURCE_DIR
-            "/targets/a3_checkerboard_8x5_40mm.yaml --bayer rggb --rig " RIGCAL_SOURCE_DIR
-            "/data/sample_rig.yaml --out " +
-            (dir_ / (name + ".yaml")).string() + " --report " + (dir_ / name).string(),
+        "calibrate " + session.string() +
+            " --rig " RIGCAL_SOURCE_DIR "/data/sample_rig.yaml --target " RIGCAL_SOURCE_DIR
+            "/targets/a3_checkerboard_8x5_40mm.yaml --bayer rggb --only cameras --out " +
+            (dir_ / name).string(),
         dir_);
     EXPECT_EQ(r.status, 0) << r.err;
-    return rig::read_rig_file(dir_ / (name + ".yaml"));
+    return nlohmann::json::parse(
+        std::ifstream(dir_ / name / "reports" / "cameras" / "cameras.json"));
   };
-  const rig::Rig direct = calibrate(sim_out / "stereo", "direct");
-  const rig::Rig captured = calibrate(o.out, "captured");
+  const nlohmann::json direct = calibrate(sim_out / "stereo", "direct");
+  const nlohmann::json captured = calibrate(o.out, "captured");
   // The same calibration within a third of its own uncertainty: the recording holds each view two
   // or three times, so the views weigh a little differently.
-  const nlohmann::json sigmas =
-      nlohmann::json::parse(std::ifstream(dir_ / "direct" / "cameras.json"));
   for (int k = 0; k < 2; ++k) {
-    const char* cam = k == 0 ? "cam_l" : "cam_r";
-    const rig::CameraModel& a = rig::sensor(direct, cam).camera;
-    const rig::CameraModel& b = rig::sensor(captured, cam).camera;
-    const std::vector<double> sigma = sigmas["cameras"][k]["stddev"]["intrinsics"];
+    const std::vector<double> a = direct["cameras"][k]["model"]["intrinsics"];
+    const std::vector<double> b = captured["cameras"][k]["model"]["intrinsics"];
+    const std::vector<double> sigma = direct["cameras"][k]["stddev"]["intrinsics"];
+    ASSERT_EQ(a.size(), 4u);
+    ASSERT_EQ(b.size(), 4u);
     ASSERT_EQ(sigma.size(), 4u);
-    EXPECT_LT(std::abs(a.fx - b.fx), sigma[0] / 3) << cam;
-    EXPECT_LT(std::abs(a.fy - b.fy), sigma[1] / 3) << cam;
-    EXPECT_LT(std::abs(a.cx - b.cx), sigma[2] / 3) << cam;
-    EXPECT_LT(std::abs(a.cy - b.cy), sigma[3] / 3) << cam;
+    for (int i = 0; i < 4; ++i)
+      EXPECT_LT(std::abs(a[i] - b[i]), sigma[i] / 3) << folders[k] << " " << i;
   }
+  EXPECT_GE(captured["cameras"][0]["n_views"].get<size_t>(), 16u) << "every pair's view";
 }
 
 }  // namespace
