@@ -90,7 +90,7 @@ Assistant::~Assistant() {
   impl_->worker.join();
 }
 
-void Assistant::offer(size_t index, const cv::Mat& frame, Time) {
+void Assistant::offer(size_t index, const cv::Mat& frame) {
   {
     std::lock_guard lock(impl_->mutex);
     CameraState& c = impl_->cameras.at(index);

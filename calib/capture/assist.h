@@ -17,7 +17,6 @@
 #include <vector>
 
 #include "rigcal/camera/target.h"
-#include "rigcal/core/time.h"
 #include "rigcal/io/image_io.h"
 
 namespace rigcal::capture {
@@ -58,7 +57,7 @@ class Assistant {
   Assistant& operator=(const Assistant&) = delete;
   // A frame of camera `index`; taken (shared, not copied) only when that camera's last one was
   // looked at more than every_s ago and the assistant is not busy with it. Never blocks.
-  void offer(size_t index, const cv::Mat& frame, Time stamp);
+  void offer(size_t index, const cv::Mat& frame);
   std::vector<CameraCoverage> coverage() const;
   // One line a camera for a person.
   static std::vector<std::string> lines(const std::vector<CameraCoverage>& coverage);

@@ -91,8 +91,10 @@ std::string describe(const CameraInfo& info) {
                      info.serial.empty() ? "unknown" : info.serial);
 }
 
+void enable_fake_interface() { arv_enable_interface("Fake"); }
+
 std::vector<CameraInfo> list_cameras(bool open_each, bool include_fake) {
-  if (include_fake) arv_enable_interface("Fake");
+  if (include_fake) enable_fake_interface();
   arv_update_device_list();
   std::vector<CameraInfo> out;
   for (unsigned i = 0; i < arv_get_n_devices(); ++i) {
@@ -140,12 +142,9 @@ Camera::Camera(const std::string& id) : impl_(std::make_unique<Impl>()) {
   impl_->camera = arv_camera_new(id.c_str(), &error);
   const std::string why = take_error(error);
   if (!impl_->camera) {
-    arv_update_device_list();
     std::string seen;
-    for (unsigned i = 0; i < arv_get_n_devices(); ++i)
-      seen +=
-          fmt::format("{}{} ({})", seen.empty() ? "" : ", ", text_or_empty(arv_get_device_id(i)),
-                      text_or_empty(arv_get_device_address(i)));
+    for (const CameraInfo& c : list_cameras(false))
+      seen += fmt::format("{}{} ({})", seen.empty() ? "" : ", ", c.id, c.address);
     throw Error(
         fmt::format("camera '{}' could not be opened: {} (Aravis sees {}; `rigcal capture "
                     "--list` lists them)",

@@ -23,6 +23,8 @@ struct CameraInfo {
 // too when `include_fake`), with their pixel formats when `open_each` (each camera opened once: a
 // camera streaming to another host still lists, without its formats).
 std::vector<CameraInfo> list_cameras(bool open_each, bool include_fake = false);
+// Makes Aravis' in-process fake camera, "Fake_1", openable (for trying without a camera).
+void enable_fake_interface();
 
 // A feature as asked and as the camera took it.
 struct FeatureResult {

@@ -14,6 +14,8 @@
 #include <thread>
 
 #include "rigcal/core/error.h"
+#include "rigcal/core/stats.h"
+#include "rigcal/core/text.h"
 #include "rigcal/core/version.h"
 #include "rigcal/io/files.h"
 #include "rigcal/io/image_sets.h"
@@ -23,17 +25,10 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-std::string number_text(double x) { return fmt::format("{}", x); }
-
 double thread_cpu_seconds() {
   timespec t{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
-bool is_colour_mosaic(const std::string& pixel_format) {
-  return pixel_format.rfind("Bayer", 0) == 0 || pixel_format.rfind("RGB", 0) == 0 ||
-         pixel_format.rfind("BGR", 0) == 0;
 }
 
 // The frames a camera's receiver hands its writer.
@@ -115,7 +110,7 @@ void receive(Recorder& r, const std::atomic<bool>& stop, std::atomic<bool>& fail
       return true;
     }
     account_id(r, e.frame.frame_id);
-    if (r.assistant) r.assistant->offer(r.index, e.frame.image, e.frame.host_stamp);
+    if (r.assistant) r.assistant->offer(r.index, e.frame.image);
     ++r.queued;
     r.queue.push(std::move(e.frame));
     return true;
@@ -206,7 +201,6 @@ void write_frames(Recorder& r, const std::filesystem::path& folder, io::CaptureS
     {
       std::lock_guard lock(r.record_mutex);
       r.record.stamps.push_back(t);
-      r.record.host_stamps.push_back(f.host_stamp);
     }
     ++r.written;
   }
@@ -219,9 +213,7 @@ void write_frames(Recorder& r, const std::filesystem::path& folder, io::CaptureS
 double median_interval_s(const std::vector<Time>& stamps) {
   std::vector<double> d;
   for (size_t i = 1; i < stamps.size(); ++i) d.push_back((stamps[i] - stamps[i - 1]).seconds());
-  if (d.empty()) return 0;
-  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-  return d[d.size() / 2];
+  return d.empty() ? 0 : median(d);
 }
 
 // Mono or raw Bayer, 8 bits or unpacked in 16 (what camera.cpp writes as it comes).
@@ -301,8 +293,8 @@ std::vector<FeatureResult> configure(Camera& camera, const io::CaptureCameraConf
   if (free_running) {
     if (camera.has("AcquisitionFrameRateEnable"))
       set({"AcquisitionFrameRateEnable"}, "true", false, "frame_rate_hz");
-    set({"AcquisitionFrameRate", "AcquisitionFrameRateAbs"}, number_text(c.frame_rate_hz),
-        c.frame_rate_given, fmt::format("frame_rate_hz: {}", number_text(c.frame_rate_hz)));
+    set({"AcquisitionFrameRate", "AcquisitionFrameRateAbs"}, format_double(c.frame_rate_hz),
+        c.frame_rate_given, fmt::format("frame_rate_hz: {}", format_double(c.frame_rate_hz)));
   }
   if (camera.has("TriggerSelector")) set({"TriggerSelector"}, "FrameStart", false, trigger_why);
   set({"TriggerMode"}, free_running ? "Off" : "On", c.trigger_given || !free_running, trigger_why);
@@ -314,16 +306,16 @@ std::vector<FeatureResult> configure(Camera& camera, const io::CaptureCameraConf
           "trigger_activation: " + c.trigger_activation.value_or("RisingEdge (default)"));
   }
   if (c.exposure_us) {
-    const std::string why = fmt::format("exposure_us: {}", number_text(*c.exposure_us));
+    const std::string why = fmt::format("exposure_us: {}", format_double(*c.exposure_us));
     if (camera.has("ExposureAuto")) set({"ExposureAuto"}, "Off", false, why);
-    set({"ExposureTime", "ExposureTimeAbs"}, number_text(*c.exposure_us), true, why);
+    set({"ExposureTime", "ExposureTimeAbs"}, format_double(*c.exposure_us), true, why);
   } else {
     const std::string why = c.exposure_given ? "exposure_us: auto" : "exposure_us: auto (default)";
     if (set({"ExposureAuto"}, "Continuous", c.exposure_given, why))
       set({"ExposureAutoMax", "AutoExposureTimeAbsMax", "ExposureAutoUpperLimit",
            "AutoExposureTimeUpperLimit"},
-          number_text(c.exposure_auto_max_us), c.exposure_auto_max_given,
-          fmt::format("exposure_auto_max_us: {}{}", number_text(c.exposure_auto_max_us),
+          format_double(c.exposure_auto_max_us), c.exposure_auto_max_given,
+          fmt::format("exposure_auto_max_us: {}{}", format_double(c.exposure_auto_max_us),
                       c.exposure_auto_max_given ? "" : " (default)"));
   }
   if (c.gain) {
@@ -341,7 +333,8 @@ std::vector<FeatureResult> configure(Camera& camera, const io::CaptureCameraConf
         "{} ({}): pixel format {} is not recorded (packed, colour or YUV): give pixel_format one "
         "of Mono8/10/12/14/16 or Bayer..8/10/12/14/16 the camera has ({})",
         c.folder, describe(camera.info()), format, fmt::join(camera.info().pixel_formats, " ")));
-  if (c.balance_white_given || is_colour_mosaic(format))
+  // Colour formats were refused above: a raw mosaic is the colour camera here.
+  if (c.balance_white_given || !bayer_pattern(format).empty())
     set({"BalanceWhiteAuto"}, c.balance_white == "auto" ? "Continuous" : "Off",
         c.balance_white_given,
         "balance_white: " + c.balance_white + (c.balance_white_given ? "" : " (default)"));

@@ -55,7 +55,6 @@ struct CameraRecord {
   size_t trigger_failures = 0;           // software triggers it refused
   std::vector<std::string> id_restarts;  // ids that went back ("12 after 4071")
   std::vector<Time> stamps;              // of the files written, the chosen clock
-  std::vector<Time> host_stamps;         // of the files written
   double receive_cpu_s = 0, write_cpu_s = 0;
   size_t max_queue = 0;  // frames waiting for the writer at most
   std::string error;     // the camera lost, a write failed

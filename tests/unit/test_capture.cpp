@@ -415,7 +415,7 @@ TEST_F(CaptureSim, TwoCamerasRecordingCalibratesAsTheImagesItRecorded) {
     };
   };
   RIGCAL_REQUIRE_SIMULATOR(left, "GVC", serve(0));
-  capture::list_cameras(false, true);  // the fake interface, Fake_1
+  capture::enable_fake_interface();  // Fake_1
   std::shared_ptr<void> right;
 
   capture::RecordOptions o;
