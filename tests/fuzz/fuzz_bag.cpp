@@ -7,7 +7,7 @@
 #include "rigcal/io/bag.h"
 #include "rigcal/io/convert.h"
 
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+static int fuzz_bag(const uint8_t* data, size_t size) {
   using namespace rigcal;
   namespace fs = std::filesystem;
   static const fs::path file = fuzz::scratch() / "input.bag";
@@ -30,3 +30,4 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   return 0;
 }
+RIGCAL_FUZZ_TARGET(bag, fuzz_bag)

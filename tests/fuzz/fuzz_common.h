@@ -1,6 +1,7 @@
 #pragma once
-// What the fuzz targets share (doc/testing.md, "Fuzzing"): a scratch folder of this process for
-// the readers that take a path, and the splitting of one input into several files.
+// What the fuzz targets share (doc/testing.md, "Fuzzing"): their registration in the one fuzzing
+// binary, a scratch folder of this process for the readers that take a path, and the splitting of
+// one input into several files.
 #include <unistd.h>
 
 #include <cstdint>
@@ -17,6 +18,12 @@
 #include "rigcal/core/error.h"
 
 namespace rigcal::fuzz {
+
+// One binary, rigcal_fuzz, holds every target (one build and one link, not one a target): each
+// file registers its function under the target's name, and the binary runs the one named by the
+// link it is called through (fuzz_<target>) or by RIGCAL_FUZZ_TARGET (fuzz_main.cpp).
+using Target = int (*)(const uint8_t* data, size_t size);
+bool register_target(const char* name, Target target);
 
 // A folder of this process in /dev/shm (memory, not the disk; the system's temporary folder where
 // there is none), removed at a normal exit. A crash leaves it behind: rigcal-fuzz-<pid>.
@@ -78,3 +85,8 @@ void expect_only_rigcal_errors(F&& f) {
 }
 
 }  // namespace rigcal::fuzz
+
+// At a file's end: RIGCAL_FUZZ_TARGET(rig_yaml, fuzz_rig_yaml).
+#define RIGCAL_FUZZ_TARGET(name, function)                           \
+  [[maybe_unused]] static const bool rigcal_fuzz_registered_##name = \
+      ::rigcal::fuzz::register_target(#name, &function);

@@ -4,7 +4,7 @@
 #include "rigcal/camera/report.h"
 #include "rigcal/io/target_yaml.h"
 
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+static int fuzz_corners_vnl(const uint8_t* data, size_t size) {
   using namespace rigcal;
   static const camera::Target target = io::parse_target_yaml(
       "target_type: checkerboard\ntargetCols: 9\ntargetRows: 6\nrowSpacingMeters: 0.025\n"
@@ -14,3 +14,4 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       [&] { camera::parse_corners_vnl(fuzz::as_text(data, size), target); });
   return 0;
 }
+RIGCAL_FUZZ_TARGET(corners_vnl, fuzz_corners_vnl)

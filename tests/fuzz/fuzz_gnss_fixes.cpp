@@ -3,7 +3,7 @@
 #include "fuzz_common.h"
 #include "rigcal/io/gnss_fixes.h"
 
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+static int fuzz_gnss_fixes(const uint8_t* data, size_t size) {
   using namespace rigcal;
   for (const std::optional<io::Attitude> a :
        {std::optional(io::Attitude::enu), std::optional(io::Attitude::ned),
@@ -20,3 +20,4 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       [&] { io::parse_geodetic_origin(fuzz::as_text(data, size), "--enu-origin"); });
   return 0;
 }
+RIGCAL_FUZZ_TARGET(gnss_fixes, fuzz_gnss_fixes)

@@ -6,7 +6,7 @@
 #include "fuzz_common.h"
 #include "rigcal/io/image_io.h"
 
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+static int fuzz_image(const uint8_t* data, size_t size) {
   using namespace rigcal;
   static const std::filesystem::path file = fuzz::scratch() / "image";
   fuzz::write_file(file, fuzz::as_text(data, size));
@@ -23,3 +23,4 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   return 0;
 }
+RIGCAL_FUZZ_TARGET(image, fuzz_image)

@@ -2,9 +2,10 @@
 #include "fuzz_common.h"
 #include "rigcal/io/ground_truth_io.h"
 
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+static int fuzz_marker_survey(const uint8_t* data, size_t size) {
   using namespace rigcal;
   fuzz::expect_only_rigcal_errors(
       [&] { io::parse_marker_survey(fuzz::as_text(data, size), "markers.csv"); });
   return 0;
 }
+RIGCAL_FUZZ_TARGET(marker_survey, fuzz_marker_survey)

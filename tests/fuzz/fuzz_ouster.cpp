@@ -8,7 +8,7 @@
 #include "rigcal/io/ouster_metadata.h"
 #include "rigcal/io/ouster_pcap.h"
 
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+static int fuzz_ouster(const uint8_t* data, size_t size) {
   using namespace rigcal;
   const std::vector<std::string_view> parts =
       fuzz::split_parts(fuzz::as_text(data, size), "--pcap--");
@@ -38,3 +38,4 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   });
   return 0;
 }
+RIGCAL_FUZZ_TARGET(ouster, fuzz_ouster)

@@ -3,7 +3,7 @@
 #include "fuzz_common.h"
 #include "rigcal/io/rates_io.h"
 
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+static int fuzz_rates_vbr(const uint8_t* data, size_t size) {
   using namespace rigcal;
   namespace fs = std::filesystem;
   static const fs::path dir = fuzz::scratch() / "imu";
@@ -16,3 +16,4 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   fuzz::expect_only_rigcal_errors([&] { io::read_rates(dir); });
   return 0;
 }
+RIGCAL_FUZZ_TARGET(rates_vbr, fuzz_rates_vbr)

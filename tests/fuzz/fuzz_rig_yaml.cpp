@@ -3,7 +3,7 @@
 #include "fuzz_common.h"
 #include "rigcal/rig/rig_yaml.h"
 
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+static int fuzz_rig_yaml(const uint8_t* data, size_t size) {
   using namespace rigcal;
   std::optional<rig::Rig> parsed;
   fuzz::expect_only_rigcal_errors(
@@ -24,3 +24,4 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   return 0;
 }
+RIGCAL_FUZZ_TARGET(rig_yaml, fuzz_rig_yaml)

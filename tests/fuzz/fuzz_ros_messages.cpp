@@ -4,7 +4,7 @@
 #include "fuzz_common.h"
 #include "rigcal/io/ros_messages.h"
 
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+static int fuzz_ros_messages(const uint8_t* data, size_t size) {
   using namespace rigcal;
   if (size == 0) return 0;
   const std::string_view bytes = fuzz::as_text(data + 1, size - 1);
@@ -46,3 +46,4 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   });
   return 0;
 }
+RIGCAL_FUZZ_TARGET(ros_messages, fuzz_ros_messages)

@@ -4,7 +4,7 @@
 #include "fuzz_common.h"
 #include "rigcal/io/session.h"
 
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+static int fuzz_session(const uint8_t* data, size_t size) {
   using namespace rigcal;
   namespace fs = std::filesystem;
   static const fs::path root = [] {
@@ -28,3 +28,4 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   });
   return 0;
 }
+RIGCAL_FUZZ_TARGET(session, fuzz_session)

@@ -3,7 +3,7 @@
 #include "fuzz_common.h"
 #include "rigcal/io/sim_config.h"
 
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+static int fuzz_sim_config(const uint8_t* data, size_t size) {
   using namespace rigcal;
   static const std::string file = (fuzz::scratch() / "sim.yaml").string();
   sim::SimConfig config;
@@ -11,3 +11,4 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       [&] { io::apply_sim_config(fuzz::as_text(data, size), file, config); });
   return 0;
 }
+RIGCAL_FUZZ_TARGET(sim_config, fuzz_sim_config)

@@ -2,7 +2,7 @@
 #include "fuzz_common.h"
 #include "rigcal/io/target_yaml.h"
 
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+static int fuzz_target_yaml(const uint8_t* data, size_t size) {
   using namespace rigcal;
   std::optional<camera::Target> parsed;
   fuzz::expect_only_rigcal_errors(
@@ -17,3 +17,4 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   return 0;
 }
+RIGCAL_FUZZ_TARGET(target_yaml, fuzz_target_yaml)

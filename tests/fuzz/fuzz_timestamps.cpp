@@ -6,7 +6,7 @@
 #include "fuzz_common.h"
 #include "rigcal/io/image_sets.h"
 
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+static int fuzz_timestamps(const uint8_t* data, size_t size) {
   using namespace rigcal;
   namespace fs = std::filesystem;
   static const fs::path topic = [] {
@@ -28,3 +28,4 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   });
   return 0;
 }
+RIGCAL_FUZZ_TARGET(timestamps, fuzz_timestamps)

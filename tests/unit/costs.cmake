@@ -7,7 +7,6 @@ set(rigcal_slow_tests
     CheckSim.AnUnchangedRigIsConsistentAndATurnedCameraIsFlaggedOnItself 78
     GroundTruthSim.AShortWalksMarkersAndTrajectoryAgainstTheTruth 49
     Session.CalibrateNamesTheFailedStepThenRerunsOnlyIt 42
-    OdometryPeersOnKitti.RigcalPutsTheSixteenKittiSweepsOnEachOtherAtLeastAsWellAsOpen3dAndPcl 41
     Session.CalibrateOnBagsIsCalibrateOnTheirConversionAndOnTheFolders 40
     CameraSim.EquidistantMeetsTheTruthBar 28
     LidarCameraSim.TenPairsWithClutter 26

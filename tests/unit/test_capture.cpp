@@ -298,9 +298,11 @@ TEST_F(CaptureSim, SoftwareTriggeredFramesAreCountedAndEqualTheSimulatorsImages)
   const capture::CameraRecord& c = run.cameras[0];
   EXPECT_EQ(run.stopped_by, "frames");
   EXPECT_EQ(c.triggers_sent, 30u);
-  // A frame a trigger, but for the simulator's start: it streams up to half a second after the
-  // acquisition starts, later on a loaded machine, and makes one frame of the triggers before.
-  EXPECT_GE(c.written, 29u);
+  // A frame a trigger, but for the simulator's start: it streams about half a second after the
+  // acquisition starts, later on a loaded machine (measured up to 0.15 s after the first trigger
+  // in CI, which lost two of them), and makes one frame of the triggers before. The recording's
+  // own loss is what the test judges: every frame made is on disk, with no gap in the ids.
+  EXPECT_GE(c.written, 25u);
   EXPECT_EQ(c.written, sim->frames_made()) << "every frame the simulator made is on disk";
   EXPECT_EQ(c.missing, 0u);
   EXPECT_EQ(c.incomplete, 0u);
