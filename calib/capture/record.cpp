@@ -31,21 +31,29 @@ double thread_cpu_seconds() {
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
-// The frames a camera's receiver hands its writer.
+// The frames a camera's receiver hands its writer, and their bytes.
 struct FrameQueue {
   std::mutex mutex;
   std::condition_variable ready;
   std::deque<Frame> frames;
   bool closed = false;
   size_t max_size = 0;
+  size_t bytes = 0, max_bytes = 0;
 
-  void push(Frame f) {
+  // The frame is queued whatever happens (it was received: it is written); false when the
+  // frames waiting now hold more than `limit_bytes`.
+  bool push(Frame f, size_t limit_bytes) {
+    bool within = true;
     {
       std::lock_guard lock(mutex);
+      bytes += f.image.total() * f.image.elemSize();
       frames.push_back(std::move(f));
       max_size = std::max(max_size, frames.size());
+      max_bytes = std::max(max_bytes, bytes);
+      within = bytes <= limit_bytes;
     }
     ready.notify_one();
+    return within;
   }
   void close() {
     {
@@ -61,6 +69,7 @@ struct FrameQueue {
     if (frames.empty()) return false;
     f = std::move(frames.front());
     frames.pop_front();
+    bytes -= f.image.total() * f.image.elemSize();
     return true;
   }
 };
@@ -80,6 +89,7 @@ struct Recorder {
   size_t index = 0;
   std::optional<uint64_t> last_id;  // the receiver's
   size_t queued = 0;                // the receiver's: frames handed to the writer
+  size_t max_waiting_bytes = 0;     // frames received and not written, at most
 };
 
 void account_id(Recorder& r, uint64_t id) {
@@ -112,7 +122,19 @@ void receive(Recorder& r, const std::atomic<bool>& stop, std::atomic<bool>& fail
     account_id(r, e.frame.frame_id);
     if (r.assistant) r.assistant->offer(r.index, e.frame.image);
     ++r.queued;
-    r.queue.push(std::move(e.frame));
+    if (!r.queue.push(std::move(e.frame), r.max_waiting_bytes)) {
+      // The disk does not keep up: memory would grow until the system kills the recording.
+      // Stopped here, everything received is still written.
+      std::lock_guard lock(r.record_mutex);
+      if (r.record.error.empty())
+        r.record.error = fmt::format(
+            "{}: the frames waiting to be written passed max_waiting_mb ({} MB) after {} frames, "
+            "{} of them written: writing PNGs falls behind the camera (a slower disk or CPU than "
+            "the frame rate needs); every frame received is written. Record to a faster disk, at "
+            "a lower rate, or raise max_waiting_mb in the capture config",
+            r.record.folder, r.max_waiting_bytes >> 20, r.queued, r.written.load());
+      failed = true;
+    }
     return true;
   };
   while (!stop) {
@@ -397,6 +419,7 @@ CaptureRun record(const RecordOptions& o) {
     r->record.pixel_format = cameras.back()->get("PixelFormat").value_or("");
     r->record.trigger = c.trigger;
     r->gige = r->record.info.protocol == "GigEVision";
+    r->max_waiting_bytes = static_cast<size_t>(o.config.max_waiting_mb) << 20;
     if (o.on_configured) o.on_configured(c, *cameras.back());
     recorders.push_back(std::move(r));
   }
@@ -551,6 +574,7 @@ CaptureRun record(const RecordOptions& o) {
     r->record.written = r->written;
     r->record.missing = r->missing;
     r->record.max_queue = r->queue.max_size;
+    r->record.max_waiting_mb = static_cast<double>(r->queue.max_bytes) / (1 << 20);
     if (r->record.trigger == "Software") {
       r->record.triggers_sent = triggers - r->trigger_failures;
       r->record.trigger_failures = r->trigger_failures;
@@ -618,6 +642,7 @@ nlohmann::json capture_report(const CaptureRun& run) {
          {"cpu_percent_of_a_core",
           run.seconds > 0 ? 100 * (c.receive_cpu_s + c.write_cpu_s) / run.seconds : 0.0},
          {"max_frames_waiting", c.max_queue},
+         {"max_waiting_mb", c.max_waiting_mb},
          {"error", c.error}});
   }
   json coverage = json::array();

@@ -56,8 +56,9 @@ struct CameraRecord {
   std::vector<std::string> id_restarts;  // ids that went back ("12 after 4071")
   std::vector<Time> stamps;              // of the files written, the chosen clock
   double receive_cpu_s = 0, write_cpu_s = 0;
-  size_t max_queue = 0;  // frames waiting for the writer at most
-  std::string error;     // the camera lost, a write failed
+  size_t max_queue = 0;       // frames waiting for the writer at most
+  double max_waiting_mb = 0;  // and their megabytes (MiB)
+  std::string error;          // the camera lost, a write failed
 };
 
 struct CaptureRun {

@@ -146,6 +146,8 @@ CaptureConfig parse_capture_config(std::string_view text, std::string_view file)
         fail_at(file, yaml_line(v), key, fmt::format("expected host or camera, got '{}'", s));
     } else if (key == "buffers") {
       config.buffers = whole(v, file, key, 2, 1000);
+    } else if (key == "max_waiting_mb") {
+      config.max_waiting_mb = whole(v, file, key, 1, 1 << 20);
     } else if (key == "cameras") {
       have_cameras = true;
       if (!v.IsMap() || v.size() == 0)
@@ -159,7 +161,8 @@ CaptureConfig parse_capture_config(std::string_view text, std::string_view file)
         config.cameras.push_back(parse_camera(folder, cam.second, file));
       }
     } else {
-      fail_at(file, yaml_line(kv.first), key, "unknown key (expected cameras, stamps, buffers)");
+      fail_at(file, yaml_line(kv.first), key,
+              "unknown key (expected cameras, stamps, buffers, max_waiting_mb)");
     }
   }
   if (!have_cameras) fail_at(file, 0, "cameras", "missing: the cameras to record");

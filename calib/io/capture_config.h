@@ -4,6 +4,8 @@
 //
 //   stamps: host                 # host (the host's clock when the frame arrived) | camera
 //   buffers: 16                  # stream buffers a camera
+//   max_waiting_mb: 1024         # frames received and not yet written, a camera, at most: past
+//                                # it the disk does not keep up and the recording stops
 //   cameras:
 //     camera_left:               # the recording's folder (camera_left | camera_right)
 //       id: 192.168.1.10         # what Aravis opens: its device id, serial number or address
@@ -61,6 +63,7 @@ struct CaptureConfig {
   std::vector<CaptureCameraConfig> cameras;
   CaptureStamps stamps = CaptureStamps::host;
   int buffers = 16;
+  int max_waiting_mb = 1024;
 };
 
 std::string_view to_string(CaptureStamps stamps);

@@ -41,6 +41,7 @@ foreach(name CaptureSim.FeaturesAreSetAndReadBackAndTheMissingDefaultsReported
              CaptureSim.SoftwareTriggeredFramesAreCountedAndEqualTheSimulatorsImages
              CaptureSim.AnInterruptMidStreamLosesNothing
              CaptureSim.ACameraLostMidStreamIsNamedAndWhatWasRecordedKept
+             CaptureSim.AWriterFallingBehindStopsTheRecordingAndWritesWhatWasReceived
              CaptureSim.TwoCamerasRecordingCalibratesAsTheImagesItRecorded)
   set_tests_properties(${name} PROPERTIES RESOURCE_LOCK gige_simulator)
 endforeach()

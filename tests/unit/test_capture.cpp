@@ -91,7 +91,7 @@ class CaptureSim : public testing::ScratchTest {
 
 TEST(CaptureConfig, ReadsTheCamerasAndNamesWhatIsWrong) {
   const io::CaptureConfig c = io::parse_capture_config(
-      "stamps: camera\nbuffers: 8\ncameras:\n"
+      "stamps: camera\nbuffers: 8\nmax_waiting_mb: 512\ncameras:\n"
       "  camera_left:\n    id: 192.168.1.10\n    region: [0, 0, 1388, 700]\n    trigger: Line0\n"
       "    exposure_us: auto\n    exposure_auto_max_us: 15000\n    gain: 2.5\n"
       "    features:\n      GevSCPSPacketSize: 9000\n      StreamBytesPerSecond: 115000000\n"
@@ -100,6 +100,9 @@ TEST(CaptureConfig, ReadsTheCamerasAndNamesWhatIsWrong) {
   ASSERT_EQ(c.cameras.size(), 2u);
   EXPECT_EQ(c.stamps, io::CaptureStamps::camera);
   EXPECT_EQ(c.buffers, 8);
+  EXPECT_EQ(c.max_waiting_mb, 512);
+  EXPECT_EQ(io::parse_capture_config("cameras:\n  camera_left: {id: a}\n", "d.yaml").max_waiting_mb,
+            1024);
   EXPECT_EQ(c.cameras[0].trigger, "Line0");
   EXPECT_TRUE(c.cameras[0].exposure_given && !c.cameras[0].exposure_us);
   EXPECT_EQ(c.cameras[0].exposure_auto_max_us, 15000);
@@ -134,6 +137,9 @@ TEST(CaptureConfig, ReadsTheCamerasAndNamesWhatIsWrong) {
   EXPECT_EQ(error("stamps: gps\ncameras:\n  camera_left: {id: a}\n"),
             "c.yaml:1: key 'stamps': expected host or camera, got 'gps'");
   EXPECT_EQ(error("buffers: 4\n"), "c.yaml: key 'cameras': missing: the cameras to record");
+  EXPECT_EQ(error("max_waiting_mb: 0\ncameras:\n  camera_left: {id: a}\n")
+                .rfind("c.yaml:1: key 'max_waiting_mb': ", 0),
+            0u);
   EXPECT_EQ(error("buffers: 4.5\ncameras:\n  camera_left: {id: a}\n"),
             "c.yaml:1: key 'buffers': expected a whole number, got '4.5'");
   EXPECT_EQ(error("cameras:\n  camera_left: {id: a, trigger: Line0, frame_rate_hz: 30}\n"),
@@ -354,6 +360,34 @@ TEST_F(CaptureSim, AnInterruptMidStreamLosesNothing) {
   EXPECT_EQ(lines_of(o.out / "camera_left" / "timestamps.txt").size(), c.written);
   EXPECT_EQ(pngs_in(o.out / "camera_left" / "data"), c.written);
   EXPECT_EQ(sim->frames_made(), c.written) << "every frame the simulator made is on disk";
+}
+
+// A writer that falls behind the camera (a slow disk) stops the recording before memory runs out:
+// the frames waiting are bounded (max_waiting_mb; none here, so the first frame passes it), the
+// message says what happened and what to do, and every frame received is on disk.
+TEST_F(CaptureSim, AWriterFallingBehindStopsTheRecordingAndWritesWhatWasReceived) {
+  RIGCAL_REQUIRE_SIMULATOR(sim, "GVW");
+  capture::RecordOptions o;
+  o.config.cameras = {mono("camera_left", "127.0.0.1")};
+  o.config.max_waiting_mb = 0;
+  o.out = dir_ / "rec";
+  o.duration_s = 30;
+  const capture::CaptureRun run = capture::record(o);
+  EXPECT_EQ(run.stopped_by, "error");
+  const capture::CameraRecord& c = run.cameras.at(0);
+  EXPECT_EQ(run.error.rfind("camera_left: the frames waiting to be written passed max_waiting_mb "
+                            "(0 MB) after 1 frames, 0 of them written: writing PNGs falls behind",
+                            0),
+            0u)
+      << run.error;
+  EXPECT_NE(run.error.find("raise max_waiting_mb"), std::string::npos) << run.error;
+  EXPECT_GE(c.written, 1u);
+  EXPECT_EQ(c.missing, 0u);
+  EXPECT_EQ(c.written, sim->frames_made()) << "every frame received is on disk";
+  EXPECT_EQ(pngs_in(o.out / "camera_left" / "data"), c.written);
+  const nlohmann::json report = nlohmann::json::parse(std::ifstream(o.out / "capture.json"));
+  EXPECT_EQ(report["error"], run.error);
+  EXPECT_GT(report["cameras"][0]["max_waiting_mb"].get<double>(), 0.0);
 }
 
 // A camera gone mid-stream: the message names it, what was recorded is kept and readable.
