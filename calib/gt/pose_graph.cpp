@@ -358,7 +358,8 @@ std::vector<PositionFix> position_fixes(const Trajectory& T_enu_gnss,
                                         const std::vector<Eigen::Vector3d>& std_enu_m,
                                         const std::vector<int>& status, double time_offset_s,
                                         const PoseGraphConfig& config,
-                                        const std::vector<FixQuality>& quality) {
+                                        const std::vector<FixQuality>& quality,
+                                        const std::vector<Eigen::Matrix3d>& covariance_enu_m2) {
   if (!std_enu_m.empty() && std_enu_m.size() != T_enu_gnss.size())
     throw Error(
         fmt::format("{} standard deviations for {} fixes", std_enu_m.size(), T_enu_gnss.size()));
@@ -366,6 +367,9 @@ std::vector<PositionFix> position_fixes(const Trajectory& T_enu_gnss,
     throw Error(fmt::format("{} fix states for {} fixes", status.size(), T_enu_gnss.size()));
   if (!quality.empty() && quality.size() != T_enu_gnss.size())
     throw Error(fmt::format("{} fix types for {} fixes", quality.size(), T_enu_gnss.size()));
+  if (!covariance_enu_m2.empty() && covariance_enu_m2.size() != std_enu_m.size())
+    throw Error(fmt::format("{} covariances for {} standard deviations", covariance_enu_m2.size(),
+                            std_enu_m.size()));
   std::vector<PositionFix> out;
   out.reserve(T_enu_gnss.size());
   const Time offset = Time::from_seconds(time_offset_s);
@@ -382,7 +386,12 @@ std::vector<PositionFix> position_fixes(const Trajectory& T_enu_gnss,
     // A receiver that does not know its accuracy reports zeros (NavSatFix's covariance type
     // unknown): its state's sigmas then.
     if (!std_enu_m.empty() && std_enu_m[i].minCoeff() > 0) {
-      f.covariance = std_enu_m[i].cwiseProduct(std_enu_m[i]).asDiagonal();
+      // The receiver's whole covariance when it gives one (NavSatFix's, type known): an
+      // elongated error ellipse keeps its axes.
+      if (!covariance_enu_m2.empty())
+        f.covariance = covariance_enu_m2[i];
+      else
+        f.covariance = std_enu_m[i].cwiseProduct(std_enu_m[i]).asDiagonal();
     } else {
       f.covariance = covariance_of(f.quality == FixQuality::rtk_fixed   ? config.sigma_rtk_fixed
                                    : f.quality == FixQuality::rtk_float ? config.sigma_rtk_float

@@ -57,13 +57,15 @@ struct PoseGraphConfig {
 // `quality` (the solution's type, one a fix, or empty) when given, else from `status`
 // (NavSatFix's, one a fix or empty: 2 RTK fixed, 0 and 1 single), else rtk_fixed; a fix whose
 // status is -1 (no fix) is left out whatever its quality. Its covariance: from the receiver's
-// standard deviations (`std_enu_m`, one a fix, or empty; zeros: not known) when given, else
+// standard deviations (`std_enu_m`, one a fix, or empty; zeros: not known) when given, the
+// whole matrix when `covariance_enu_m2` gives it (one a standard deviation, or empty), else
 // the quality's sigmas (config.sigma_rtk_fixed, sigma_rtk_float, sigma_single).
 std::vector<PositionFix> position_fixes(const Trajectory& T_enu_gnss,
                                         const std::vector<Eigen::Vector3d>& std_enu_m,
                                         const std::vector<int>& status, double time_offset_s,
                                         const PoseGraphConfig& config,
-                                        const std::vector<FixQuality>& quality = {});
+                                        const std::vector<FixQuality>& quality = {},
+                                        const std::vector<Eigen::Matrix3d>& covariance_enu_m2 = {});
 
 // The scan poses in the fixes' ENU frame. `p_lidar_antenna`: the antenna (the fixes' point) in
 // the LiDAR frame. Nothing throws on data that fix too little: the result says what is

@@ -132,7 +132,7 @@ GroundTruthRun run_ground_truth(const StepInputs& in, const StepOptions& o,
                                                       : FixQuality::single);
     }
     run.fixes = position_fixes(on_base_clock(f.T_enu_gnss, *gnss), f.std_enu_m, f.status, 0.0,
-                               o.pose_graph, quality);
+                               o.pose_graph, quality, f.covariance_enu_m2);
     if (f.std_enu_m.empty()) {
       const PoseGraphConfig& c = o.pose_graph;
       run.notes.push_back(

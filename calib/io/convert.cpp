@@ -324,13 +324,15 @@ void write_fix(Topic& t, Time stamp, const RosNavSatFix& m) {
     t.table = std::make_unique<Out>(t.dir / "navsat.csv");
     t.table->write(
         "time,latitude,longitude,height,status,service,covariance_type,std_east,std_north,"
-        "std_up\n");
+        "std_up,cov_en,cov_eu,cov_nu\n");
   }
+  // The covariance is row-major ENU (m^2): its diagonal as standard deviations, then the terms
+  // off it, which a receiver that knows its whole covariance (type 3) gives.
   const auto& c = m.position_covariance;
-  t.table->write(fmt::format("{},{},{},{},{},{},{},{},{},{}\n", to_seconds_text(stamp),
+  t.table->write(fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{}\n", to_seconds_text(stamp),
                              m.latitude_deg, m.longitude_deg, m.altitude_m, int{m.status},
                              m.service, int{m.position_covariance_type}, std::sqrt(c[0]),
-                             std::sqrt(c[4]), std::sqrt(c[8])));
+                             std::sqrt(c[4]), std::sqrt(c[8]), c[1], c[2], c[5]));
 }
 
 void write_pose(Topic& t, Time stamp, const RosPose& m) {

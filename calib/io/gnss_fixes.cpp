@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <GeographicLib/LocalCartesian.hpp>
 #include <algorithm>
@@ -9,6 +10,7 @@
 #include <cctype>
 #include <cmath>
 #include <fstream>
+#include <limits>
 
 #include "rigcal/core/error.h"
 #include "rigcal/core/se3.h"
@@ -40,6 +42,9 @@ enum Column {
   kStdU,
   kStatus,
   kFixType,
+  kCovEN,
+  kCovEU,
+  kCovNU,
   kColumns
 };
 const std::array<std::vector<std::string_view>, kColumns> kAliases = {{
@@ -55,6 +60,9 @@ const std::array<std::vector<std::string_view>, kColumns> kAliases = {{
     {"std_up", "sigma_up"},
     {"status"},
     {"fix_type", "q", "quality"},
+    {"cov_en"},
+    {"cov_eu"},
+    {"cov_nu"},
 }};
 
 // RTKLIB's Q codes, or the words.
@@ -237,6 +245,27 @@ GnssFixes parse_gnss_fixes(std::string_view text, std::string_view file_name,
                             s.z()));
       }
       out.std_enu_m.push_back(s);
+      // The off-diagonal terms (NavSatFix's full covariance, m^2), when given: the matrix must
+      // be one (positive semi-definite), a receiver's numbers are not trusted blindly.
+      if (col[kCovEN] >= 0 && col[kCovEU] >= 0 && col[kCovNU] >= 0) {
+        Eigen::Matrix3d C = s.cwiseProduct(s).asDiagonal();
+        C(0, 1) = C(1, 0) = value(kCovEN);
+        C(0, 2) = C(2, 0) = value(kCovEU);
+        C(1, 2) = C(2, 1) = value(kCovNU);
+        const double smallest = C.allFinite() ? Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(
+                                                    C, Eigen::EigenvaluesOnly)
+                                                    .eigenvalues()
+                                                    .minCoeff()
+                                              : std::numeric_limits<double>::quiet_NaN();
+        if (!(smallest >= -1e-9 * std::max(C.trace(), 1e-300))) {
+          fail_at(file_name, number, "",
+                  fmt::format("cov_en {} cov_eu {} cov_nu {} with standard deviations {} {} {}: "
+                              "not a covariance (its smallest eigenvalue, {:.3g} m^2, is below "
+                              "zero)",
+                              C(0, 1), C(0, 2), C(1, 2), s.x(), s.y(), s.z(), smallest));
+        }
+        out.covariance_enu_m2.push_back(C);
+      }
     }
     if (col[kStatus] >= 0) {
       const double status = value(kStatus);

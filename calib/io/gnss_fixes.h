@@ -5,7 +5,9 @@
 // pitch, yaw (or heading), in degrees; read for positions only (no attitude convention given),
 // the attitude columns are not needed. Optional: the standard deviations std_east, std_north,
 // std_up (m), status (sensor_msgs/NavSatFix's: -1 no fix, 0 fix, 1 SBAS, 2 GBAS/RTK; what
-// `rigcal convert` writes to navsat.csv), and fix_type (or q, quality: the solution's type, which
+// `rigcal convert` writes to navsat.csv), the covariance's off-diagonal terms cov_en, cov_eu,
+// cov_nu (m^2, with the three standard deviations: NavSatFix's full covariance, as navsat.csv
+// has it), and fix_type (or q, quality: the solution's type, which
 // NavSatFix's status cannot tell, RTK fixed from float: RTKLIB's Q codes 1 fixed, 2 float,
 // 5 single, and 3 SBAS and 4 DGPS read as single, 6 PPP as float; or the words fixed, float,
 // single; anything else is an error). Converted with GeographicLib to a local ENU frame at the
@@ -47,9 +49,12 @@ struct GnssFixes {
   Trajectory T_enu_gnss;  // without attitude (has_attitude false) every rotation is the identity
   bool has_attitude = true;
   std::vector<Eigen::Vector3d> std_enu_m;  // one a fix when the file gives them, else empty
-  std::vector<int> status;                 // one a fix when the file gives it, else empty
-  std::vector<FixType> fix_type;           // one a fix when the file gives it, else empty
-  GeodeticOrigin origin;                   // of the ENU frame
+  // One a fix when the file gives the off-diagonal terms with the standard deviations, else
+  // empty: the whole ENU covariance (m^2).
+  std::vector<Eigen::Matrix3d> covariance_enu_m2;
+  std::vector<int> status;        // one a fix when the file gives it, else empty
+  std::vector<FixType> fix_type;  // one a fix when the file gives it, else empty
+  GeodeticOrigin origin;          // of the ENU frame
   std::optional<double> median_horizontal_std_m, median_vertical_std_m;  // when given
 };
 

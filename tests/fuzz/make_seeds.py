@@ -70,6 +70,9 @@ seed("gnss_fixes", "fix_types.csv", "time,latitude,longitude,height,std_east,std
      "1000.000000000,41.8902100000,12.4922310000,69.0000,0.0100,0.0100,0.0200,2,fixed\n"
      "1000.010000000,41.8902100900,12.4922310000,69.0010,0.2000,0.2000,0.4000,2,float\n"
      "1000.020000000,41.8902101800,12.4922310000,69.0020,1.5000,1.5000,3.0000,0,single\n")
+seed("gnss_fixes", "navsat_covariance.csv",
+     "time,latitude,longitude,height,status,service,covariance_type,std_east,std_north,std_up,cov_en,cov_eu,cov_nu\n"
+     "1.0,41.9,12.5,50,2,1,3,0.02,0.03,0.05,0.0003,0.0001,-0.0002\n2.0,41.9000001,12.5,50,2,1,3,0.02,0.03,0.05,0.0003,0.0001,-0.0002\n")
 seed("gnss_fixes", "rtklib_q.csv", "time,lat,lon,height,Q\n1,41.9,12.5,50,1\n2,41.9,12.5,50,2\n3,41.9,12.5,50,5\n")
 
 seed("marker_survey", "positions.csv", "# a total station\nid,x,y,z\nM1,7.5692,-2.1187,-0.9299\n"

@@ -92,8 +92,10 @@ sensor_msgs::NavSatFix fix(int k) {
   m.header.frame_id = "gps";
   m.status.status = 2, m.status.service = 1;
   m.latitude = latitude(k), m.longitude = longitude(k), m.altitude = altitude(k);
-  m.position_covariance = {0.0004, 0, 0, 0, 0.0009, 0, 0, 0, 0.0025};
-  m.position_covariance_type = 2;
+  // A receiver that knows its whole covariance (row-major ENU, m^2): east and north correlated.
+  m.position_covariance = {0.0004,  0.0003, 0.0001,  0.0003, 0.0009,
+                           -0.0002, 0.0001, -0.0002, 0.0025};
+  m.position_covariance_type = 3;
   return m;
 }
 

@@ -19,6 +19,7 @@
 #include "rigcal/io/bag.h"
 #include "rigcal/io/convert.h"
 #include "rigcal/io/files.h"
+#include "rigcal/io/gnss_fixes.h"
 #include "rigcal/io/image_sets.h"
 #include "rigcal/io/ouster_metadata.h"
 #include "rigcal/io/ouster_pcap.h"
@@ -161,12 +162,22 @@ TEST_F(Bags, ConvertedRecordingHoldsEveryValueWritten) {
   EXPECT_EQ(rates.rates.stamps[7].ns, bag::imu_stamp_ns(7));
   EXPECT_EQ(rates.rates.rates[7].z(), bag::gyro(7, 2));
 
-  // Fixes: navsat.csv with the stamps, positions and standard deviations.
+  // Fixes: navsat.csv with the stamps, positions and the whole covariance (standard deviations,
+  // then the terms off the diagonal), which the fixes' reader takes whole.
   const std::string navsat = bytes_of(rec / "gps_fix" / "navsat.csv");
   const std::vector<TextLine> fixes = data_lines(navsat, nullptr);
   ASSERT_EQ(fixes.size(), size_t(bag::kFixes));
   const std::vector<std::string_view> g = split_fields(fixes[3].text);
-  ASSERT_EQ(g.size(), 10u);
+  ASSERT_EQ(g.size(), 13u);
+  EXPECT_EQ(g[6], "3");
+  EXPECT_EQ(parse_double(g[10], "cov_en"), 0.0003);
+  EXPECT_EQ(parse_double(g[12], "cov_nu"), -0.0002);
+  const GnssFixes read = read_gnss_fixes(rec / "gps_fix" / "navsat.csv", std::nullopt);
+  ASSERT_EQ(read.covariance_enu_m2.size(), size_t(bag::kFixes));
+  const Eigen::Matrix3d C_enu = (Eigen::Matrix3d() << 0.0004, 0.0003, 0.0001, 0.0003, 0.0009,
+                                 -0.0002, 0.0001, -0.0002, 0.0025)
+                                    .finished();
+  EXPECT_LT((read.covariance_enu_m2[3] - C_enu).cwiseAbs().maxCoeff(), 1e-15);
   EXPECT_EQ(parse_time(g[0]).ns, bag::fix_stamp_ns(3));
   EXPECT_EQ(parse_double(g[1], "lat"), bag::latitude(3));
   EXPECT_EQ(parse_double(g[2], "lon"), bag::longitude(3));

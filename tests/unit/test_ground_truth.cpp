@@ -461,6 +461,16 @@ TEST(PoseGraph, PositionFixesTakeTheReceiversSigmasItsStatesAndTheClockOffset) {
   EXPECT_NEAR(qs[0].covariance(0, 0), 0.01 * 0.01, 1e-15);  // its sigmas, not float's
   EXPECT_NEAR(std::sqrt(qs[1].covariance(0, 0)), config.sigma_single.x(), 1e-12);  // zeros
   EXPECT_THROW(gt::position_fixes(T_enu_gnss, {}, {}, 0.0, config, {Q::single}), Error);
+  // The receiver's whole covariance (NavSatFix's, type known) is kept whole; a fix whose
+  // sigmas are zeros (not known) still takes its state's.
+  Eigen::Matrix3d C;
+  C << 4e-4, 3e-4, 1e-4, 3e-4, 9e-4, -2e-4, 1e-4, -2e-4, 25e-4;
+  const std::vector<gt::PositionFix> w = gt::position_fixes(T_enu_gnss, unknown, {}, 0.0, config,
+                                                            {}, std::vector<Eigen::Matrix3d>(4, C));
+  EXPECT_EQ(w[0].covariance, C);
+  EXPECT_NEAR(std::sqrt(w[1].covariance(0, 0)), config.sigma_rtk_fixed.x(), 1e-12);
+  EXPECT_EQ(w[1].covariance(0, 1), 0.0);
+  EXPECT_THROW(gt::position_fixes(T_enu_gnss, sd, {}, 0.0, config, {}, {C}), Error);
 }
 
 // The fixes CSV read for positions (the ground truth's reading): no attitude columns needed, the
@@ -495,6 +505,25 @@ TEST(GnssFixesCsv, PositionsOnlyNeedNoAttitudeAndKeepSigmasAndStatus) {
           .find("standard deviations"),
       std::string::npos);
   EXPECT_NE(message("time,latitude,height\n1,41.9,5\n").find("'longitude'"), std::string::npos);
+  // The covariance's terms off the diagonal (navsat.csv's), read with the sigmas into the whole
+  // matrix; numbers that make no covariance refused with their line.
+  const io::GnssFixes c = io::parse_gnss_fixes(
+      "time,latitude,longitude,height,std_east,std_north,std_up,cov_en,cov_eu,cov_nu\n"
+      "1,41.9,12.5,5,0.02,0.03,0.05,0.0003,0.0001,-0.0002\n",
+      "f.csv", std::nullopt);
+  ASSERT_EQ(c.covariance_enu_m2.size(), 1u);
+  EXPECT_NEAR(c.covariance_enu_m2[0](1, 1), 0.0009, 1e-15);
+  EXPECT_EQ(c.covariance_enu_m2[0](1, 0), 0.0003);
+  EXPECT_EQ(c.covariance_enu_m2[0](2, 1), -0.0002);
+  EXPECT_TRUE(f.covariance_enu_m2.empty()) << "no off-diagonal columns: the sigmas alone";
+  const std::string bad = message(
+      "time,latitude,longitude,height,std_east,std_north,std_up,cov_en,cov_eu,cov_nu\n"
+      "1,41.9,12.5,5,0.02,0.03,0.05,0.001,0,0\n");
+  EXPECT_EQ(bad.rfind("f.csv:2: cov_en 0.001 cov_eu 0 cov_nu 0 with standard deviations 0.02 "
+                      "0.03 0.05: not a covariance",
+                      0),
+            0u)
+      << bad;
 }
 
 // The solution's type (fix_type, q or quality): RTKLIB's Q codes or words; anything else refused
