@@ -14,10 +14,7 @@ namespace capture_command {
 
 struct Options {
   capture::CaptureRequest request;
-  std::string config, out, target;
   bool list = false;
-  size_t frames = 0;
-  double duration_s = 0;
 };
 
 std::atomic<bool> interrupted{false};
@@ -32,11 +29,6 @@ void run(Options o) {
       fmt::print("{}\n", line);
     return;
   }
-  o.request.config = o.config;
-  o.request.out = o.out;
-  o.request.target = o.target;
-  if (o.frames > 0) o.request.frames = o.frames;
-  if (o.duration_s > 0) o.request.duration_s = o.duration_s;
   capture::RecordOptions options = capture::record_options(o.request, &interrupted);
   options.progress = [&config = options.config](const capture::RecordProgress& p) {
     fmt::print(stderr, "\r{}   ", capture::progress_line(p, config));
@@ -55,7 +47,8 @@ void run(Options o) {
   fmt::print(stderr, "\n");
   for (const std::string& line : capture::summary_lines(result)) fmt::print("{}\n", line);
   if (!result.error.empty())
-    throw Error(fmt::format("{}; what was recorded is kept in {}", result.error, o.out));
+    throw Error(
+        fmt::format("{}; what was recorded is kept in {}", result.error, o.request.out.string()));
 }
 
 }  // namespace capture_command
@@ -72,17 +65,18 @@ void add_capture(CLI::App& app) {
       "counted and listed in capture.json, the cameras paired by trigger. Ctrl-C stops cleanly:\n"
       "every frame received is on disk with its stamp.");
   cmd->add_flag("--list", o->list, "list the cameras Aravis sees, with their pixel formats");
-  cmd->add_option("--config", o->config, "the capture config (YAML, doc/capture.md)");
+  cmd->add_option("--config", o->request.config, "the capture config (YAML, doc/capture.md)");
   cmd->add_option("--left", o->request.left,
                   "without --config: the left camera's Aravis id, serial or address (defaults: "
                   "BayerRG8, software trigger at 10 Hz, auto exposure up to 20 ms)");
   cmd->add_option("--right", o->request.right, "without --config: the right camera");
-  cmd->add_option("--out", o->out, "the recording folder to write (new or empty)");
-  cmd->add_option("--frames", o->frames, "stop once every camera has written this many frames")
+  cmd->add_option("--out", o->request.out, "the recording folder to write (new or empty)");
+  cmd->add_option("--frames", o->request.frames,
+                  "stop once every camera has written this many frames")
       ->check(whole_count("a number of frames"));
-  cmd->add_option("--duration", o->duration_s, "stop after this many seconds")
+  cmd->add_option("--duration", o->request.duration_s, "stop after this many seconds")
       ->check(seconds_within(0.001));
-  cmd->add_option("--target", o->target,
+  cmd->add_option("--target", o->request.target,
                   "calibration assistance with this board (target YAML): the detector on a "
                   "decimated stream says which parts of the image, tilts and distances are "
                   "missing for the camera step's bars, refreshes OUT/coverage.png")

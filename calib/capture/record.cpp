@@ -31,22 +31,25 @@ double thread_cpu_seconds() {
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
-// The frames a camera's receiver hands its writer, and their bytes.
+size_t bytes_of(const Frame& f) { return f.image.total() * f.image.elemSize(); }
+
+// The frames a camera's receiver hands its writer, and their bytes, bounded by `limit_bytes`.
 struct FrameQueue {
   std::mutex mutex;
   std::condition_variable ready;
   std::deque<Frame> frames;
   bool closed = false;
+  size_t limit_bytes = 0;
   size_t max_size = 0;
   size_t bytes = 0, max_bytes = 0;
 
   // The frame is queued whatever happens (it was received: it is written); false when the
-  // frames waiting now hold more than `limit_bytes`.
-  bool push(Frame f, size_t limit_bytes) {
+  // frames waiting now hold more than the limit.
+  bool push(Frame f) {
     bool within = true;
     {
       std::lock_guard lock(mutex);
-      bytes += f.image.total() * f.image.elemSize();
+      bytes += bytes_of(f);
       frames.push_back(std::move(f));
       max_size = std::max(max_size, frames.size());
       max_bytes = std::max(max_bytes, bytes);
@@ -69,7 +72,7 @@ struct FrameQueue {
     if (frames.empty()) return false;
     f = std::move(frames.front());
     frames.pop_front();
-    bytes -= f.image.total() * f.image.elemSize();
+    bytes -= bytes_of(f);
     return true;
   }
 };
@@ -89,7 +92,6 @@ struct Recorder {
   size_t index = 0;
   std::optional<uint64_t> last_id;  // the receiver's
   size_t queued = 0;                // the receiver's: frames handed to the writer
-  size_t max_waiting_bytes = 0;     // frames received and not written, at most
 };
 
 void account_id(Recorder& r, uint64_t id) {
@@ -122,7 +124,7 @@ void receive(Recorder& r, const std::atomic<bool>& stop, std::atomic<bool>& fail
     account_id(r, e.frame.frame_id);
     if (r.assistant) r.assistant->offer(r.index, e.frame.image);
     ++r.queued;
-    if (!r.queue.push(std::move(e.frame), r.max_waiting_bytes)) {
+    if (!r.queue.push(std::move(e.frame))) {
       // The disk does not keep up: memory would grow until the system kills the recording.
       // Stopped here, everything received is still written.
       std::lock_guard lock(r.record_mutex);
@@ -132,7 +134,7 @@ void receive(Recorder& r, const std::atomic<bool>& stop, std::atomic<bool>& fail
             "{} of them written: writing PNGs falls behind the camera (a slower disk or CPU than "
             "the frame rate needs); every frame received is written. Record to a faster disk, at "
             "a lower rate, or raise max_waiting_mb in the capture config",
-            r.record.folder, r.max_waiting_bytes >> 20, r.queued, r.written.load());
+            r.record.folder, r.queue.limit_bytes >> 20, r.queued, r.written.load());
       failed = true;
     }
     return true;
@@ -419,7 +421,7 @@ CaptureRun record(const RecordOptions& o) {
     r->record.pixel_format = cameras.back()->get("PixelFormat").value_or("");
     r->record.trigger = c.trigger;
     r->gige = r->record.info.protocol == "GigEVision";
-    r->max_waiting_bytes = static_cast<size_t>(o.config.max_waiting_mb) << 20;
+    r->queue.limit_bytes = static_cast<size_t>(o.config.max_waiting_mb) << 20;
     if (o.on_configured) o.on_configured(c, *cameras.back());
     recorders.push_back(std::move(r));
   }

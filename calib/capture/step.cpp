@@ -28,7 +28,7 @@ RecordOptions record_options(const CaptureRequest& r, const std::atomic<bool>* i
   }
   if (r.fake) enable_fake_interface();
   o.out = r.out;
-  o.frames = r.frames;
+  if (r.frames && *r.frames > 0) o.frames = r.frames;  // 0: no limit, as --frames 0 says
   o.duration_s = r.duration_s;
   o.interrupt = interrupt;
   if (!r.target.empty()) {

@@ -19,7 +19,7 @@ struct CaptureRequest {
   std::filesystem::path target;  // assistance with this board ("" none)
   std::string bayer;             // the assistance's mosaic ("" from the pixel format)
   bool fake = false;             // Aravis' in-process fake camera, Fake_1, visible
-  std::optional<size_t> frames;
+  std::optional<size_t> frames;  // 0: no limit
   std::optional<double> duration_s;
 };
 
