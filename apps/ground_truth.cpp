@@ -20,11 +20,14 @@ struct Options {
   std::string out, sigmas, report, map, enu_origin, fix_correlation = "auto", fix_model = "states";
   bool no_bundle_adjustment = false, no_fusion = false;
   std::pair<size_t, size_t> windows{0, 0};  // FROM:TO; 0:0 all
+  std::pair<double, double> attitude_sigma_deg{gt::StepOptions{}.attitude_sigma_deg.x(),
+                                               gt::StepOptions{}.attitude_sigma_deg.y()};
 };
 
 void run(Options o) {
   o.step.bundle_adjustment = !o.no_bundle_adjustment;
   o.step.fuse_odometry = !o.no_fusion;
+  o.step.attitude_sigma_deg = {o.attitude_sigma_deg.first, o.attitude_sigma_deg.second};
   o.step.map = !o.map.empty();
   if (!o.enu_origin.empty())
     o.step.enu_origin = io::parse_geodetic_origin(o.enu_origin, "--enu-origin");
@@ -70,6 +73,22 @@ void add_ground_truth(CLI::App& app) {
   cmd->add_option("--covariances", o->in.covariances,
                   "its step covariances (default: ODOMETRY without extension + _covariances.txt)");
   cmd->add_option("--gnss", o->in.gnss, "GNSS/INS poses (TUM, T_enu_gnss) or fixes (CSV)");
+  cmd->add_option("--attitude", o->in.attitude,
+                  "GNSS/INS poses (T_enu_ins, any trajectory format; may be --gnss itself) whose "
+                  "rotations become priors on the LiDAR's, through the rig's INS-to-LiDAR "
+                  "rotation: they settle a standing rig's heading and the roll about a straight "
+                  "path")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--attitude-sigma-deg", o->attitude_sigma_deg,
+                  "TILT,HEADING: the attitudes' sigmas, deg (roll and pitch; heading)")
+      ->delimiter(',')
+      ->check(CLI::Range(1e-6, 180.0))
+      ->capture_default_str();
+  cmd->add_option("--attitude-correlation", o->step.pose_graph.attitude_correlation_s,
+                  "the attitudes' error correlation time, s: each prior weighs as 1 / (2 S x scan "
+                  "rate) of an independent one (0: independent)")
+      ->check(seconds_within(0, 3600))
+      ->capture_default_str();
   cmd->add_option("--gnss-sensor", o->step.gnss_sensor, "the rig's GNSS sensor")
       ->capture_default_str();
   cmd->add_option("--enu-origin", o->enu_origin,

@@ -13,6 +13,7 @@
 
 #include "rigcal/bench/metrics.h"
 #include "rigcal/core/error.h"
+#include "rigcal/gt/attitude_prior_error.h"
 #include "rigcal/gt/fix_error_state.h"
 #include "rigcal/gt/position_prior_error.h"
 #include "rigcal/gt/relative_pose_error.h"
@@ -46,38 +47,85 @@ struct Prior {
   FixQuality quality = FixQuality::rtk_fixed;
 };
 
+// Each scan with a measurement at its stamp, or two around it at most `max_gap` apart: visit(k, a,
+// b, f), scan k between measurements a and b (the same one when it is at the stamp) at fraction f
+// of the way from a to b.
+template <class Measurement, class Visit>
+void around_scans(const Trajectory& scans, const std::vector<Measurement>& m, Time max_gap,
+                  Visit visit) {
+  size_t i = 0;  // m[i] is the last measurement at or before the scan
+  for (size_t k = 0; k < scans.size(); ++k) {
+    const Time t = scans.stamps[k];
+    while (i + 1 < m.size() && m[i + 1].stamp <= t) ++i;
+    if (m.empty() || m[i].stamp > t) continue;
+    if (m[i].stamp == t) {
+      visit(k, i, i, 0.0);
+    } else if (i + 1 < m.size() && m[i + 1].stamp - m[i].stamp <= max_gap) {
+      visit(k, i, i + 1, (t - m[i].stamp).seconds() / (m[i + 1].stamp - m[i].stamp).seconds());
+    }
+  }
+}
+
 std::vector<Prior> priors_at_scans(const Trajectory& scans, const std::vector<PositionFix>& fixes,
                                    const PoseGraphConfig& config, std::vector<bool>& fix_used) {
   std::vector<Prior> out;
   fix_used.assign(fixes.size(), false);
-  const Time max_gap = Time::from_seconds(config.max_fix_gap_s);
-  size_t i = 0;  // fixes[i] is the last fix at or before the scan
-  for (size_t k = 0; k < scans.size(); ++k) {
-    const Time t = scans.stamps[k];
-    while (i + 1 < fixes.size() && fixes[i + 1].stamp <= t) ++i;
-    if (fixes.empty() || fixes[i].stamp > t) continue;
-    Prior p;
-    p.node = k;
-    if (fixes[i].stamp == t) {
-      p.fix = i;
-      p.p_enu = fixes[i].p_enu;
-      p.covariance = fixes[i].covariance;
-      p.quality = fixes[i].quality;
-    } else {
-      if (i + 1 >= fixes.size() || fixes[i + 1].stamp - fixes[i].stamp > max_gap) continue;
-      const PositionFix &a = fixes[i], &b = fixes[i + 1];
-      const double f = (t - a.stamp).seconds() / (b.stamp - a.stamp).seconds();
-      p.fix = f < 0.5 ? i : i + 1;
-      p.p_enu = (1 - f) * a.p_enu + f * b.p_enu;
-      // The less certain of the two (by the trace): a quality change is not averaged away.
-      const PositionFix& worse = a.covariance.trace() >= b.covariance.trace() ? a : b;
-      p.covariance = worse.covariance;
-      p.quality = worse.quality;
-    }
-    fix_used[p.fix] = true;
-    out.push_back(p);
-  }
+  around_scans(scans, fixes, Time::from_seconds(config.max_fix_gap_s),
+               [&](size_t k, size_t i, size_t j, double f) {
+                 const PositionFix &a = fixes[i], &b = fixes[j];
+                 Prior p;
+                 p.node = k;
+                 p.fix = f < 0.5 ? i : j;
+                 p.p_enu = (1 - f) * a.p_enu + f * b.p_enu;
+                 // The less certain of the two (by the trace): a quality change is not averaged
+                 // away.
+                 const PositionFix& worse = a.covariance.trace() >= b.covariance.trace() ? a : b;
+                 p.covariance = worse.covariance;
+                 p.quality = worse.quality;
+                 fix_used[p.fix] = true;
+                 out.push_back(p);
+               });
   return out;
+}
+
+// An attitude's prior at scan `node`: the attitude interpolated at its stamp.
+struct AttitudePrior {
+  size_t node = 0, fix = 0;
+  Eigen::Quaterniond q_enu_lidar = Eigen::Quaterniond::Identity();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
+};
+
+// As priors_at_scans: the attitudes around a scan's stamp interpolated (slerp), the covariance
+// the larger of the two.
+std::vector<AttitudePrior> attitude_priors_at_scans(const Trajectory& scans,
+                                                    const std::vector<AttitudeFix>& attitudes,
+                                                    const PoseGraphConfig& config) {
+  std::vector<AttitudePrior> out;
+  around_scans(scans, attitudes, Time::from_seconds(config.max_fix_gap_s),
+               [&](size_t k, size_t i, size_t j, double f) {
+                 const AttitudeFix &a = attitudes[i], &b = attitudes[j];
+                 AttitudePrior p;
+                 p.node = k;
+                 p.fix = f < 0.5 ? i : j;
+                 p.q_enu_lidar = a.q_enu_lidar.slerp(f, b.q_enu_lidar);
+                 p.covariance =
+                     a.covariance.trace() >= b.covariance.trace() ? a.covariance : b.covariance;
+                 out.push_back(p);
+               });
+  return out;
+}
+
+// The rotation taking the odometry's rotations onto the measured attitudes: the chordal mean of
+// q_measured * q_odom^-1 over the priors.
+Eigen::Matrix3d rotation_from_attitudes(const std::vector<AttitudePrior>& priors,
+                                        const Trajectory& scans) {
+  Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
+  for (const AttitudePrior& p : priors)
+    sum += p.q_enu_lidar.toRotationMatrix() * scans.T_world_body[p.node].R.transpose();
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(sum, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
+  d(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1.0 : 1.0;
+  return svd.matrixU() * d * svd.matrixV().transpose();
 }
 
 // The rotation and translation taking odometry positions onto fix positions (least squares);
@@ -145,13 +193,15 @@ struct PriorModel {
   double scale = 1.0;
   double correlation_s = 0.0;
   double white_fraction = 0.1;
+  double attitude_scale = 1.0;  // the attitudes' covariances scaled by their correlation
 };
 
 // The graph over the poses with the odometry's edges and the priors not rejected; the first
 // pose's rotation held when the fixes do not determine it.
 void build(Graph& g, const OdometryInput& odometry, const std::vector<Prior>& priors,
            const std::vector<PriorResidual>& state, const Eigen::Vector3d& p_lidar_antenna,
-           const PriorModel& model, bool hold_rotation) {
+           const PriorModel& model, bool hold_rotation, const std::vector<AttitudePrior>& attitudes,
+           const std::vector<AttitudeResidual>& attitude_state) {
   const bool states = !g.fix_errors.empty();
   const std::vector<SE3>& T_odom_lidar = odometry.T_odom_lidar.T_world_body;
   for (size_t k = 0; k + 1 < g.poses.size(); ++k) {
@@ -183,6 +233,15 @@ void build(Graph& g, const OdometryInput& odometry, const std::vector<Prior>& pr
             p.p_enu, p_lidar_antenna, sqrt_information<3>(model.scale * p.covariance)});
     g.prior_blocks.push_back(g.problem.AddResidualBlock(
         cost, loss, g.poses[p.node].q.coeffs().data(), g.poses[p.node].t.data()));
+  }
+  for (size_t j = 0; j < attitudes.size(); ++j) {
+    if (attitude_state[j].rejected) continue;
+    const AttitudePrior& p = attitudes[j];
+    auto* cost = new ceres::AutoDiffCostFunction<AttitudePriorError, 3, 4>(new AttitudePriorError{
+        p.q_enu_lidar, sqrt_information<3>(model.attitude_scale * p.covariance)});
+    g.problem.AddResidualBlock(
+        cost, model.robust_sigmas > 0 ? new ceres::HuberLoss(model.robust_sigmas) : nullptr,
+        g.poses[p.node].q.coeffs().data());
   }
   if (states) {
     // A receiver's error is one process while its solution keeps its kind: where the fixes'
@@ -402,6 +461,37 @@ std::vector<PositionFix> position_fixes(const Trajectory& T_enu_gnss,
   return out;
 }
 
+std::vector<AttitudeFix> attitude_fixes(const Trajectory& T_enu_ins,
+                                        const Eigen::Quaterniond& q_ins_lidar, double time_offset_s,
+                                        const Eigen::Vector2d& sigma_rad) {
+  if (!(sigma_rad.minCoeff() > 0))
+    throw Error(
+        fmt::format("the attitudes' sigmas must be above zero (tilt {} rad, heading {} rad)",
+                    sigma_rad.x(), sigma_rad.y()));
+  const bool all_identity =
+      std::all_of(T_enu_ins.T_world_body.begin(), T_enu_ins.T_world_body.end(),
+                  [](const SE3& T) { return T.R.isIdentity(1e-12); });
+  if (all_identity && !T_enu_ins.empty())
+    throw Error(
+        "every rotation is the identity: positions written as poses carry no attitude (give the "
+        "GNSS/INS's own poses, or no attitudes)");
+  const Eigen::Matrix3d covariance =
+      Eigen::Vector3d(sigma_rad.x() * sigma_rad.x(), sigma_rad.x() * sigma_rad.x(),
+                      sigma_rad.y() * sigma_rad.y())
+          .asDiagonal();
+  std::vector<AttitudeFix> out;
+  out.reserve(T_enu_ins.size());
+  const Time offset = Time::from_seconds(time_offset_s);
+  for (size_t i = 0; i < T_enu_ins.size(); ++i) {
+    AttitudeFix a;
+    a.stamp = T_enu_ins.stamps[i] + offset;
+    a.q_enu_lidar = (T_enu_ins.T_world_body[i].quaternion() * q_ins_lidar).normalized();
+    a.covariance = covariance;
+    out.push_back(a);
+  }
+  return out;
+}
+
 std::vector<Matrix6d> chain_marginals(const std::vector<Matrix6d>& D,
                                       const std::vector<Matrix6d>& B) {
   return block_chain_marginals(D, B);
@@ -415,7 +505,8 @@ std::vector<Matrix9d> chain_marginals(const std::vector<Matrix9d>& D,
 PoseGraphResult solve_pose_graph(const OdometryInput& odometry,
                                  const std::vector<PositionFix>& fixes,
                                  const Eigen::Vector3d& p_lidar_antenna,
-                                 const PoseGraphConfig& config) {
+                                 const PoseGraphConfig& config,
+                                 const std::vector<AttitudeFix>& attitudes) {
   const Trajectory& scans = odometry.T_odom_lidar;
   const size_t n = scans.size();
   if (n == 0) throw Error("the odometry has no poses");
@@ -429,6 +520,8 @@ PoseGraphResult solve_pose_graph(const OdometryInput& odometry,
   PoseGraphResult out;
   std::vector<bool> fix_used;
   const std::vector<Prior> priors = priors_at_scans(scans, fixes, config, fix_used);
+  const std::vector<AttitudePrior> attitude_priors =
+      attitude_priors_at_scans(scans, attitudes, config);
   out.fixes_unused = size_t(std::count(fix_used.begin(), fix_used.end(), false));
   if (priors.empty()) {
     out.undetermined.push_back(
@@ -464,17 +557,19 @@ PoseGraphResult solve_pose_graph(const OdometryInput& odometry,
     p_enu.push_back(p.p_enu);
   }
   int spread_axes = 0;
-  const SE3 T_enu_odom = initial_alignment(p_odom, p_enu, config.min_spread_m, spread_axes);
-  // A standing rig: its rotation is the odometry's, held. Fixes along a line: solved, and the
-  // rotation about the line judged by its marginal sigma below.
-  const bool hold_rotation = spread_axes == 0;
-  if (spread_axes == 0) {
-    out.undetermined.push_back(
-        {"the rotation (heading, roll and pitch)",
-         fmt::format("the fixes spread less than {} m: the rig stood still; the odometry's "
-                     "rotation is kept. Move the rig over a few metres in two directions.",
-                     config.min_spread_m)});
+  const SE3 T_enu_odom_by_fixes =
+      initial_alignment(p_odom, p_enu, config.min_spread_m, spread_axes);
+  SE3 T_enu_odom = T_enu_odom_by_fixes;
+  // Fixes that do not turn the odometry by themselves (a point, a line): the attitudes do.
+  if (spread_axes < 2 && !attitude_priors.empty()) {
+    Eigen::Vector3d mean_odom = Eigen::Vector3d::Zero(), mean_enu = Eigen::Vector3d::Zero();
+    for (size_t j = 0; j < p_odom.size(); ++j) mean_odom += p_odom[j], mean_enu += p_enu[j];
+    T_enu_odom.R = rotation_from_attitudes(attitude_priors, scans);
+    T_enu_odom.t = (mean_enu - T_enu_odom.R * mean_odom) / double(p_odom.size());
   }
+  // A standing rig without attitudes: its rotation is the odometry's, held. Fixes along a line:
+  // solved, and the rotation about the line judged by its marginal sigma below.
+  bool hold_rotation = spread_axes == 0 && attitude_priors.empty();
   // Priors closer in time than the fixes' correlation share their error.
   double prior_scale = 1.0;
   if (config.fix_correlation_s > 0 && n >= 2) {
@@ -482,6 +577,17 @@ PoseGraphResult solve_pose_graph(const OdometryInput& odometry,
     // A first-order Gauss-Markov error of correlation time tau averages over a span T as
     // T / (2 tau) independent samples would.
     prior_scale = std::max(1.0, 2.0 * config.fix_correlation_s * scan_rate);
+  }
+  double attitude_scale = 1.0;
+  if (config.attitude_correlation_s > 0 && n >= 2) {
+    const double scan_rate = double(n - 1) / (scans.stamps.back() - scans.stamps.front()).seconds();
+    attitude_scale = std::max(1.0, 2.0 * config.attitude_correlation_s * scan_rate);
+  }
+  out.attitude_priors.resize(attitude_priors.size());
+  for (size_t j = 0; j < attitude_priors.size(); ++j) {
+    out.attitude_priors[j].fix = attitude_priors[j].fix;
+    out.attitude_priors[j].node = attitude_priors[j].node;
+    out.attitude_priors[j].stamp = scans.stamps[attitude_priors[j].node];
   }
 
   out.priors.resize(priors.size());
@@ -504,13 +610,23 @@ PoseGraphResult solve_pose_graph(const OdometryInput& odometry,
       r.residual_enu = b.q * p_lidar_antenna + b.t - priors[j].p_enu;
       r.mahalanobis2 = r.residual_enu.dot(priors[j].covariance.ldlt().solve(r.residual_enu));
     }
+    for (size_t j = 0; j < attitude_priors.size(); ++j) {
+      AttitudeResidual& r = out.attitude_priors[j];
+      r.residual_enu =
+          rotation_vector(at[attitude_priors[j].node].q.toRotationMatrix() *
+                          attitude_priors[j].q_enu_lidar.toRotationMatrix().transpose());
+      r.mahalanobis2 =
+          r.residual_enu.dot(attitude_priors[j].covariance.ldlt().solve(r.residual_enu));
+    }
   };
   // Solve 1, robust, its priors' covariances scaled by the correlation; the gate.
   {
     Graph g;
     g.poses = poses;
-    build(g, odometry, priors, out.priors, p_lidar_antenna,
-          {config.robust_sigmas, prior_scale, 0.0, config.fix_white_fraction}, hold_rotation);
+    PriorModel model{config.robust_sigmas, prior_scale, 0.0, config.fix_white_fraction};
+    model.attitude_scale = attitude_scale;
+    build(g, odometry, priors, out.priors, p_lidar_antenna, model, hold_rotation, attitude_priors,
+          out.attitude_priors);
     const ceres::Solver::Summary summary = solve(g, config.max_iterations);
     if (!summary.IsSolutionUsable())
       throw Error("the pose graph's solve failed: " + summary.message);
@@ -519,6 +635,32 @@ PoseGraphResult solve_pose_graph(const OdometryInput& odometry,
     poses = g.poses;
     prior_residuals(poses);
     for (PriorResidual& r : out.priors) r.rejected = r.mahalanobis2 > config.gate_chi2;
+    for (AttitudeResidual& r : out.attitude_priors) r.rejected = r.mahalanobis2 > config.gate_chi2;
+  }
+  out.attitudes_rejected =
+      size_t(std::count_if(out.attitude_priors.begin(), out.attitude_priors.end(),
+                           [](const AttitudeResidual& r) { return r.rejected; }));
+  // A standing rig whose attitudes the gate rejected, every one: held as without them.
+  // A standing rig whose attitudes the gate rejected, every one: held as without them, from the
+  // odometry moved onto the fixes alone.
+  if (spread_axes == 0 && !hold_rotation && out.attitudes_rejected == out.attitude_priors.size()) {
+    hold_rotation = true;
+    for (size_t k = 0; k < n; ++k) {
+      const SE3 T_enu_lidar = T_enu_odom_by_fixes * scans.T_world_body[k];
+      poses[k] = {T_enu_lidar.quaternion(), T_enu_lidar.t};
+    }
+  }
+  if (hold_rotation) {
+    out.undetermined.push_back(
+        {"the rotation (heading, roll and pitch)",
+         fmt::format("the fixes spread less than {} m: the rig stood still; the odometry's "
+                     "rotation is kept. {}",
+                     config.min_spread_m,
+                     attitude_priors.empty()
+                         ? "Move the rig over a few metres in two directions, or give the "
+                           "GNSS/INS's attitudes."
+                         : "Every GNSS/INS attitude was rejected by the gate: check the rig's "
+                           "rotation between the INS and the LiDAR.")});
   }
   const auto kept = std::count_if(out.priors.begin(), out.priors.end(),
                                   [](const PriorResidual& r) { return !r.rejected; });
@@ -540,13 +682,15 @@ PoseGraphResult solve_pose_graph(const OdometryInput& odometry,
     Graph g;
     g.poses = start ? start->poses : poses;
     PriorModel model{0.0, prior_scale, 0.0, white_fraction};
+    model.attitude_scale = attitude_scale;
     if (states) {
       g.fix_errors =
           start ? start->fix_errors : std::vector<Eigen::Vector3d>(n, Eigen::Vector3d::Zero());
       model.scale = 1.0;
       model.correlation_s = tau_s;
     }
-    build(g, odometry, priors, out.priors, p_lidar_antenna, model, hold_rotation);
+    build(g, odometry, priors, out.priors, p_lidar_antenna, model, hold_rotation, attitude_priors,
+          out.attitude_priors);
     const ceres::Solver::Summary summary = solve(g, config.max_iterations);
     if (!summary.IsSolutionUsable())
       throw Error("the pose graph's solve failed: " + summary.message);

@@ -48,6 +48,11 @@ struct PoseGraphConfig {
   // when its marginal sigma is above this, deg: a near-straight path leaves the rotation about
   // it to the lever arm and the path's small bends.
   double max_rotation_sigma_deg = 1.0;
+  // GNSS/INS attitudes (when given): their errors drift too (an INS's heading over tens of
+  // seconds); each attitude prior's covariance is multiplied by how many scans fall in twice
+  // this time (at least 1), as the fixes' are by fix_correlation_s with the scaled model. 0:
+  // independent.
+  double attitude_correlation_s = 10.0;
   int max_iterations = 100;
   bool covariances = true;
 };
@@ -67,10 +72,15 @@ std::vector<PositionFix> position_fixes(const Trajectory& T_enu_gnss,
                                         const std::vector<FixQuality>& quality = {},
                                         const std::vector<Eigen::Matrix3d>& covariance_enu_m2 = {});
 
-// The scan poses in the fixes' ENU frame. `p_lidar_antenna`: the antenna (the fixes' point) in
-// the LiDAR frame. Nothing throws on data that fix too little: the result says what is
-// undetermined (no prior at all: no pose; a standing rig: the rotation held at the odometry's;
-// a rotation sigma above max_rotation_sigma_deg, or none on a line: said, the poses kept).
+// The LiDAR's attitudes from GNSS/INS poses (T_enu_ins on the INS's clock: their rotations are
+// used), through the rig's rotation `q_ins_lidar`, stamps moved to the base clock by
+// `time_offset_s`; each with the covariance of `sigma_rad`: tilt (about east and north) and
+// heading (about up), rad. Throws rigcal::Error when every rotation is the identity (a file of
+// positions written as poses carries no attitude).
+std::vector<AttitudeFix> attitude_fixes(const Trajectory& T_enu_ins,
+                                        const Eigen::Quaterniond& q_ins_lidar, double time_offset_s,
+                                        const Eigen::Vector2d& sigma_rad);
+
 // The fixes' error correlation time, s, from the residuals of the priors a solve kept (time
 // order; each prior's residual is its fix's error, less what the solve took up): the first lag
 // at which their autocorrelation falls below 1/e, over pairs of priors that lag apart in scans
@@ -84,10 +94,19 @@ std::vector<PositionFix> position_fixes(const Trajectory& T_enu_gnss,
 double estimate_fix_correlation(const std::vector<PriorResidual>& priors,
                                 const std::vector<PositionFix>& fixes, double max_s = 120.0);
 
+// The scan poses in the fixes' ENU frame. `p_lidar_antenna`: the antenna (the fixes' point) in
+// the LiDAR frame. Nothing throws on data that fix too little: the result says what is
+// undetermined (no prior at all: no pose; a standing rig without attitudes: the rotation held at
+// the odometry's; a rotation sigma above max_rotation_sigma_deg, or none on a line: said, the
+// poses kept).
+// `attitudes` (GNSS/INS, optional) are priors on the poses' rotations, interpolated at the scans'
+// stamps as the fixes are, gated with them; they settle what the fixes leave (a standing rig's
+// heading, the roll about a straight path).
 PoseGraphResult solve_pose_graph(const OdometryInput& odometry,
                                  const std::vector<PositionFix>& fixes,
                                  const Eigen::Vector3d& p_lidar_antenna,
-                                 const PoseGraphConfig& config);
+                                 const PoseGraphConfig& config,
+                                 const std::vector<AttitudeFix>& attitudes = {});
 
 // The marginal covariance of every pose of a chain: H block tridiagonal (pose k tied to k - 1 and
 // k + 1 only), given by its diagonal blocks D (n of them) and the blocks B[k] = H(k, k + 1)

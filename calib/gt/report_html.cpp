@@ -22,6 +22,9 @@ std::string rms(const json& s) {
   return s.is_object() ? html_number(s["rms"], "{:.1f}", 1e3) : "-";
 }
 
+// The RMS of a {rms, median, max} statistic in deg ("-" when there is none: null).
+std::string rms_deg(const json& s) { return s.is_object() ? html_number(s["rms"], "{:.3f}") : "-"; }
+
 // "median / max" of a {rms, median, max} statistic, scaled.
 std::string median_max(const json& s, const char* format, double scale) {
   if (!s.is_object()) return "-";
@@ -240,6 +243,20 @@ std::string ground_truth_html(const json& r, const std::string& top_view_svg) {
        median_max(s["pose_sigma_vertical_m"], "{:.1f}", 1e3)},
       {"pose 1-sigma, yaw median / max [deg]", median_max(s["pose_sigma_yaw_deg"], "{:.3f}", 1)},
   };
+  if (const json a = s.value("attitudes", json()); a.is_object()) {
+    rows.push_back(
+        {"GNSS/INS attitudes (priors on the rotation)",
+         fmt::format("{} priors ({} rejected); 1-sigma tilt {} deg, heading {} deg, correlated "
+                     "over {} s",
+                     html_number(a["priors"], "{:.0f}"),
+                     html_number(a["priors_rejected"], "{:.0f}"),
+                     html_number(a["sigma_tilt_deg"], "{:.3g}"),
+                     html_number(a["sigma_heading_deg"], "{:.3g}"),
+                     html_number(a["correlation_s"], "{:.3g}"))});
+    rows.push_back({"attitude residuals, tilt / heading RMS [deg]",
+                    fmt::format("{} / {}", rms_deg(a["residual_tilt_deg"]),
+                                rms_deg(a["residual_heading_deg"]))});
+  }
   for (const json& o : s.value("outages", json::array())) {
     rows.push_back({"outage", fmt::format("{} s without a fix from {} s, bridged by the odometry",
                                           html_number(o["duration_s"], "{:.1f}"),

@@ -158,8 +158,28 @@ GroundTruthRun run_ground_truth(const StepInputs& in, const StepOptions& o,
     run.fixes = position_fixes(on_base_clock(T_enu_gnss, *gnss), {}, {}, 0.0, o.pose_graph);
     run.notes.push_back(fmt::format(
         "{}: GNSS/INS poses without accuracies: their positions taken as RTK fixed (horizontal {} "
-        "m, vertical {} m); their attitude is not used",
-        in.gnss.string(), o.pose_graph.sigma_rtk_fixed.x(), o.pose_graph.sigma_rtk_fixed.y()));
+        "m, vertical {} m){}",
+        in.gnss.string(), o.pose_graph.sigma_rtk_fixed.x(), o.pose_graph.sigma_rtk_fixed.y(),
+        in.attitude == in.gnss ? ""
+                               : "; their attitude is not used (--attitude takes it as priors)"));
+  }
+  if (!in.attitude.empty()) {
+    if (gnss->gnss_frame != "ins") {
+      throw Error(fmt::format(
+          "--attitude {}: the rig's {} is a GNSS antenna (gnss_frame: {}), which has no attitude; "
+          "attitudes need the GNSS/INS's INS frame as the rig's GNSS sensor",
+          in.attitude.string(), o.gnss_sensor, gnss->gnss_frame));
+    }
+    const Trajectory T_enu_ins = io::read_trajectory(in.attitude).trajectory;
+    const Eigen::Quaterniond q_ins_lidar =
+        (gnss->T_base_sensor.inverse() * lidar->T_base_sensor).quaternion();
+    try {
+      run.attitudes = attitude_fixes(on_base_clock(T_enu_ins, *gnss), q_ins_lidar, 0.0,
+                                     o.attitude_sigma_deg * M_PI / 180.0);
+      run.attitude_correlation_s = o.pose_graph.attitude_correlation_s;
+    } catch (const Error& e) {
+      throw Error(fmt::format("{}: {}", in.attitude.string(), e.what()));
+    }
   }
   report::tell(progress, "reading the GNSS", 1, 1);
 
@@ -168,24 +188,25 @@ GroundTruthRun run_ground_truth(const StepInputs& in, const StepOptions& o,
   auto solve = [&](const OdometryInput& motions) {
     PoseGraphConfig config = o.pose_graph;
     if (config.fix_correlation_s >= 0)
-      return solve_pose_graph(motions, run.fixes, run.p_lidar_antenna, config);
+      return solve_pose_graph(motions, run.fixes, run.p_lidar_antenna, config, run.attitudes);
     // A solve that takes the fixes as more independent than they are follows their drift, and
     // its residuals understate the correlation: estimated again from each solve's residuals
     // until it settles (within 10 %, at most 6 solves).
     config.fix_correlation_s = 0;
-    PoseGraphResult g = solve_pose_graph(motions, run.fixes, run.p_lidar_antenna, config);
+    PoseGraphResult g =
+        solve_pose_graph(motions, run.fixes, run.p_lidar_antenna, config, run.attitudes);
     run.fix_correlation_estimated = true;
     for (int solves = 1; solves < 6; ++solves) {
       const double tau = estimate_fix_correlation(g.priors, run.fixes);
       if (std::abs(tau - config.fix_correlation_s) <= 0.1 * tau) break;
       config.fix_correlation_s = tau;
-      g = solve_pose_graph(motions, run.fixes, run.p_lidar_antenna, config);
+      g = solve_pose_graph(motions, run.fixes, run.p_lidar_antenna, config, run.attitudes);
     }
     // With the fixes' error as states, the time that makes the fixes most likely (the loop's
     // estimate still sets the gate's first solve).
     if (config.fix_error_states) {
       config.fix_correlation_by_likelihood = true;
-      g = solve_pose_graph(motions, run.fixes, run.p_lidar_antenna, config);
+      g = solve_pose_graph(motions, run.fixes, run.p_lidar_antenna, config, run.attitudes);
     }
     run.fix_correlation_s = g.fix_correlation_s;
     return g;
@@ -301,6 +322,7 @@ nlohmann::json ground_truth_report(const GroundTruthRun& run, const StepInputs& 
   j["inputs"] = {{"odometry", in.odometry.string()},
                  {"scans", in.scans.string()},
                  {"gnss", in.gnss.string()},
+                 {"attitude", in.attitude.string()},
                  {"rig", in.rig_source}};
   if (run.odometry) j["inputs"]["odometry_preset"] = run.odometry_preset;
   j["frame"] = run.origin ? nlohmann::json{{"enu_origin",
@@ -339,6 +361,25 @@ nlohmann::json ground_truth_report(const GroundTruthRun& run, const StepInputs& 
       size_t(std::count_if(run.fixes.begin(), run.fixes.end(), [](const PositionFix& f) {
         return f.quality == FixQuality::rtk_fixed;
       }));
+  // The attitudes' residuals kept: tilt (about east and north) and heading (about up), deg.
+  std::vector<double> tilt_deg, heading_deg;
+  for (const AttitudeResidual& a : g.attitude_priors) {
+    if (a.rejected) continue;
+    tilt_deg.push_back(a.residual_enu.head<2>().norm() * 180.0 / M_PI);
+    heading_deg.push_back(std::abs(a.residual_enu.z()) * 180.0 / M_PI);
+  }
+  nlohmann::json attitudes;
+  if (!run.attitudes.empty()) {
+    const Eigen::Matrix3d& c = run.attitudes.front().covariance;
+    attitudes = {{"attitudes", run.attitudes.size()},
+                 {"sigma_tilt_deg", std::sqrt(c(0, 0)) * 180.0 / M_PI},
+                 {"sigma_heading_deg", std::sqrt(c(2, 2)) * 180.0 / M_PI},
+                 {"correlation_s", run.attitude_correlation_s},
+                 {"priors", g.attitude_priors.size()},
+                 {"priors_rejected", g.attitudes_rejected},
+                 {"residual_tilt_deg", stats(tilt_deg)},
+                 {"residual_heading_deg", stats(heading_deg)}};
+  }
   j["summary"] = {
       {"poses", g.T_enu_lidar.size()},
       {"path_length_m", g.T_enu_lidar.empty() ? 0.0 : path_length(g.T_enu_lidar)},
@@ -361,6 +402,7 @@ nlohmann::json ground_truth_report(const GroundTruthRun& run, const StepInputs& 
            ? "the most likely, with the white share (the final solve's marginal likelihood)"
            : "estimated from the solves' prior residuals"},
       {"fix_white_share", g.fix_white_fraction},
+      {"attitudes", attitudes},
       {"fix_model", !(run.fix_correlation_s > 0) ? "independent"
                     : g.fix_white_fraction > 0   ? "a Gauss-Markov error state at every scan"
                                                  : "each prior's covariance scaled"},
@@ -500,6 +542,18 @@ nlohmann::json ground_truth_report(const GroundTruthRun& run, const StepInputs& 
                       {"rejected", p.rejected}});
   }
   j["priors"] = std::move(priors);
+  if (!run.attitudes.empty()) {
+    nlohmann::json rows = nlohmann::json::array();
+    for (const AttitudeResidual& a : g.attitude_priors) {
+      rows.push_back({{"stamp_s", to_seconds_text(a.stamp)},
+                      {"pose", a.node},
+                      {"attitude", a.fix},
+                      {"residual_enu_deg", report::vector_json(a.residual_enu * 180.0 / M_PI)},
+                      {"mahalanobis2", a.mahalanobis2},
+                      {"rejected", a.rejected}});
+    }
+    j["attitude_priors"] = std::move(rows);
+  }
   return j;
 }
 
@@ -511,6 +565,20 @@ std::string ground_truth_summary(const GroundTruthRun& run, const nlohmann::json
                   s["poses"].get<size_t>(), s["path_length_m"].get<double>(),
                   s["fixes"].get<size_t>(), s["fixes_rtk_fixed"].get<size_t>(),
                   s["priors"].get<size_t>(), s["priors_rejected"].get<size_t>());
+  if (const nlohmann::json& a = s["attitudes"]; !a.is_null()) {
+    out += fmt::format(
+        "GNSS/INS attitudes: {} (sigmas: tilt {} deg, heading {} deg), priors {} ({} "
+        "rejected)",
+        a["attitudes"].get<size_t>(), a["sigma_tilt_deg"].get<double>(),
+        a["sigma_heading_deg"].get<double>(), a["priors"].get<size_t>(),
+        a["priors_rejected"].get<size_t>());
+    if (!a["residual_tilt_deg"].is_null()) {
+      out += fmt::format("; residuals: tilt rms {:.3f} deg, heading rms {:.3f} deg",
+                         a["residual_tilt_deg"]["rms"].get<double>(),
+                         a["residual_heading_deg"]["rms"].get<double>());
+    }
+    out += "\n";
+  }
   for (const auto& [from, to] : run.graph.outages)
     out += fmt::format("outage: {:.1f} s without a fix, bridged by the odometry\n",
                        (to - from).seconds());
@@ -616,6 +684,7 @@ StepInputs step_inputs(const InputFiles& files, const StepOptions& options,
   in.rig = rig::read_rig_file(files.rig);
   in.rig_source = files.rig.string();
   in.gnss = files.gnss.empty() ? default_gnss(files.recording) : files.gnss;
+  in.attitude = files.attitude;
   in.scans = scans_of(files.recording, files.scans, !files.odometry.empty(),
                       options.bundle_adjustment || options.map || !files.markers.empty(), progress);
   if (!files.odometry.empty()) in.odometry = files.odometry, in.covariances = files.covariances;
@@ -643,6 +712,7 @@ GroundTruthPaths ground_truth_paths(const fs::path& out, const fs::path& sigmas,
                                   {paths.map, ""},
                                   {io::step_covariances_beside(out), ""}},
                                  {{"gnss", in.gnss},
+                                  {"attitude", in.attitude},
                                   {"markers", in.markers_file},
                                   {"odometry", in.odometry},
                                   {"covariances", in.covariances},

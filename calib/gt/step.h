@@ -30,6 +30,10 @@ struct StepOptions {
   // must share one frame. GNSS/INS poses, already in their ENU frame, refuse it.
   std::optional<io::GeodeticOrigin> enu_origin;
   PoseGraphConfig pose_graph;
+  // The GNSS/INS attitudes' sigmas (StepInputs::attitude): tilt (roll and pitch, about east and
+  // north) and heading, deg. The defaults are conservative for an RTK GNSS/INS (SBG's Ellipse-D
+  // states 0.05 deg and 0.2 deg).
+  Eigen::Vector2d attitude_sigma_deg{0.1, 0.5};
   // rigcal's odometry, when it runs on StepInputs::scans (lidar::choose_preset).
   std::string odometry_preset;
   bool odometry_sweep_motion = false;
@@ -57,6 +61,10 @@ struct StepInputs {
   std::filesystem::path scans;
   // GNSS/INS poses (T_enu_gnss; their positions are used) or a CSV of fixes (positions only).
   std::filesystem::path gnss;
+  // GNSS/INS poses whose rotations are the INS frame's attitude in the fixes' ENU frame
+  // (T_enu_ins, any trajectory format; the rig's GNSS sensor must be its INS frame), taken as
+  // priors on the LiDAR's rotation; empty: none.
+  std::filesystem::path attitude;
   rig::Rig rig;  // the lever arm (the GNSS sensor's T_b) and its clock (time_offset)
   std::string rig_source;
   // The motions of a job array's chunks of windows (each a trajectory and its step covariances
@@ -81,6 +89,8 @@ struct GroundTruthRun {
   double fusion_disagreeing_fraction = 0;
   bool fused = false;
   std::vector<PositionFix> fixes;
+  std::vector<AttitudeFix> attitudes;  // when StepInputs::attitude was given
+  double attitude_correlation_s = 0;   // their correlation time (PoseGraphConfig's)
   Eigen::Vector3d p_lidar_antenna = Eigen::Vector3d::Zero();
   std::optional<io::GeodeticOrigin> origin;    // of the ENU frame, when the GNSS gave fixes
   std::optional<lidar::OdometryRun> odometry;  // when rigcal's ran here
@@ -146,7 +156,7 @@ std::filesystem::path scans_of(const std::filesystem::path& recording,
 
 // The files a `rigcal ground-truth` run names (empty: not given).
 struct InputFiles {
-  std::filesystem::path recording, rig, gnss, scans, odometry, covariances, markers;
+  std::filesystem::path recording, rig, gnss, attitude, scans, odometry, covariances, markers;
   std::vector<std::filesystem::path> window_motions;
 };
 // A run's inputs from the files it names: the rig read, the GNSS file (default_gnss when none),

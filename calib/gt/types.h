@@ -3,6 +3,7 @@
 // relative motions with their covariances, GNSS position fixes with theirs, and the poses the
 // pose graph puts in the local ENU frame of the fixes, each with its covariance.
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <optional>
 #include <string>
 #include <vector>
@@ -29,6 +30,16 @@ struct PositionFix {
   FixQuality quality = FixQuality::rtk_fixed;
 };
 
+// The LiDAR's attitude in the local ENU frame as a GNSS/INS measures it (its INS frame's
+// attitude through the rig's rotation between the two), on the base clock. Its error is a
+// rotation vector in the ENU frame, q_enu_lidar = Exp(e) q_true with e ~ N(0, covariance): the
+// first two axes are the tilt (about east and north), the third the heading (about up).
+struct AttitudeFix {
+  Time stamp;
+  Eigen::Quaterniond q_enu_lidar = Eigen::Quaterniond::Identity();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // rad^2, ENU
+};
+
 // The scans' poses from the odometry, and each step's covariance: steps[k] is the motion from
 // pose k to pose k + 1, T_prev_cur = perturbed(truth, e) with e ~ N(0, covariance) (rigcal's
 // tangent: rotation first, left perturbation, in the previous sensor frame).
@@ -47,6 +58,18 @@ struct PriorResidual {
   bool rejected = false;
 };
 
+// An attitude's prior as the pose graph used it.
+struct AttitudeResidual {
+  size_t fix = 0;   // index into the attitudes
+  size_t node = 0;  // the scan pose it constrains
+  Time stamp;
+  // The estimate's rotation from the measured one, a rotation vector in ENU (rad): east and north
+  // the tilt, up the heading.
+  Eigen::Vector3d residual_enu = Eigen::Vector3d::Zero();
+  double mahalanobis2 = 0;  // against the attitude's own covariance (chi-square, 3 dof)
+  bool rejected = false;
+};
+
 // What the data cannot fix, said in words (and the data that would).
 struct Undetermined {
   std::string what, why;
@@ -57,6 +80,9 @@ struct PoseGraphResult {
   std::vector<Matrix6d> covariance;  // one a pose, rigcal's tangent in the ENU frame
   std::vector<PriorResidual> priors;
   size_t rejected = 0;
+  // The GNSS/INS attitudes' priors, when attitudes were given, and how many the gate rejected.
+  std::vector<AttitudeResidual> attitude_priors;
+  size_t attitudes_rejected = 0;
   size_t fixes_unused = 0;                     // no scan within the interpolation gap
   std::vector<std::pair<Time, Time>> outages;  // scan spans with no prior, longer than the gap
   std::vector<Undetermined> undetermined;

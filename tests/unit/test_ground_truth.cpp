@@ -237,7 +237,38 @@ struct Synthetic {
       fixes.push_back(f);
     }
   }
+
+  // GNSS/INS attitudes of the LiDAR at every scan, each off the truth by independent rotations
+  // about ENU's axes of `tilt_rad` (east, north) and `heading_rad` (up).
+  std::vector<gt::AttitudeFix> attitudes;
+  void make_attitudes(double tilt_rad, double heading_rad, uint64_t seed = 2) {
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<double> N;
+    for (size_t k = 0; k < truth.size(); ++k) {
+      const Eigen::Vector3d e(tilt_rad * N(rng), tilt_rad * N(rng), heading_rad * N(rng));
+      gt::AttitudeFix a;
+      a.stamp = truth.stamps[k];
+      a.q_enu_lidar = Eigen::Quaterniond(SE3::from_rotation_vector(e, Eigen::Vector3d::Zero()).R *
+                                         truth.T_world_body[k].R);
+      a.covariance =
+          Eigen::Vector3d(tilt_rad * tilt_rad, tilt_rad * tilt_rad, heading_rad * heading_rad)
+              .asDiagonal();
+      attitudes.push_back(a);
+    }
+  }
 };
+
+// The share of the poses whose rotation error lies within the 3-sigma ellipsoid of its marginal
+// covariance (14.16: chi-square with 3 degrees of freedom at 99.73 %).
+double rotations_within_3_sigma(const gt::PoseGraphResult& r, const Trajectory& truth) {
+  size_t within = 0;
+  for (size_t k = 0; k < truth.size(); ++k) {
+    const Eigen::Vector3d e =
+        rotation_vector(r.T_enu_lidar.T_world_body[k].R * truth.T_world_body[k].R.transpose());
+    within += e.dot(r.covariance[k].topLeftCorner<3, 3>().ldlt().solve(e)) <= 14.16;
+  }
+  return double(within) / double(truth.size());
+}
 
 // `seconds` at 10 Hz of T_enu_lidar(t).
 Trajectory truth_of(double seconds, const std::function<SE3(double)>& T_enu_lidar) {
@@ -309,6 +340,68 @@ TEST(PoseGraph, ARigStandingStillHasItsPositionButNoHeading) {
   EXPECT_LT(*std::max_element(errors_m.begin(), errors_m.end()), 0.0145);
 }
 
+// The same standing rig with a GNSS/INS's attitudes (0.1 deg of tilt, 0.5 deg of heading, white):
+// the heading is now determined, within its sigma, and the sigmas are given.
+TEST(PoseGraph, ARigStandingStillHasItsHeadingFromTheInsAttitudes) {
+  Synthetic s;
+  s.truth = truth_of(30, [](double) {
+    return SE3::from_rotation_vector(Eigen::Vector3d(0, 0, 2.0), Eigen::Vector3d(3, 4, 0.5));
+  });
+  // An odometry that keeps the rotation (1e-6 rad a step): the heading is the attitudes' alone.
+  s.make(1e-6, 1e-3, 0.02, [](double) { return true; });
+  const double tilt = 0.1 * M_PI / 180, heading = 0.5 * M_PI / 180;
+  s.make_attitudes(tilt, heading);
+  gt::PoseGraphConfig config;
+  config.attitude_correlation_s = 0;  // the attitudes here are independent
+  const gt::PoseGraphResult r =
+      gt::solve_pose_graph(s.odometry, s.fixes, s.p_lidar_antenna, config, s.attitudes);
+  ASSERT_EQ(r.T_enu_lidar.size(), s.truth.size());
+  EXPECT_TRUE(r.undetermined.empty()) << r.undetermined[0].what << ": " << r.undetermined[0].why;
+  ASSERT_EQ(r.covariance.size(), s.truth.size());
+  ASSERT_EQ(r.attitude_priors.size(), s.truth.size());
+  // The gate rejects 0.1 % of good attitudes (its chi-square quantile): 0.3 of 301 expected.
+  EXPECT_LE(r.attitudes_rejected, 2u);
+  // 301 attitudes of 0.5 deg on a rig whose odometry barely turns: the heading to about
+  // 0.5 / sqrt(301) = 0.029 deg.
+  const double sigma_heading = std::sqrt(r.covariance[150](2, 2));
+  const Eigen::Vector3d e =
+      rotation_vector(r.T_enu_lidar.T_world_body[150].R * s.truth.T_world_body[150].R.transpose());
+  std::printf("[ figures ] a standing rig with attitudes: heading error %.4f deg, sigma %.4f deg\n",
+              e.z() * 180 / M_PI, sigma_heading * 180 / M_PI);
+  EXPECT_NEAR(sigma_heading, heading / std::sqrt(301.0), 0.2 * heading / std::sqrt(301.0));
+  EXPECT_LT(std::abs(e.z()), 4 * sigma_heading);
+  EXPECT_GE(rotations_within_3_sigma(r, s.truth), 0.95);
+  // Taken as correlated over 10 s (the default), the same attitudes weigh as 301 / 200 of them:
+  // the sigma grows to match.
+  const gt::PoseGraphResult c = gt::solve_pose_graph(s.odometry, s.fixes, s.p_lidar_antenna,
+                                                     gt::PoseGraphConfig{}, s.attitudes);
+  ASSERT_EQ(c.covariance.size(), s.truth.size());
+  EXPECT_NEAR(std::sqrt(c.covariance[150](2, 2)) / sigma_heading, std::sqrt(200.0), 0.5);
+}
+
+// Attitudes that agree with nothing (a random rotation each, the rig's INS rotation wrong by
+// everything): every one is rejected by the gate, and the standing rig is held as without them.
+TEST(PoseGraph, AttitudesThatAgreeWithNothingAreRejectedAndSaidSo) {
+  Synthetic s;
+  s.truth = truth_of(10, [](double) {
+    return SE3::from_rotation_vector(Eigen::Vector3d(0, 0, 2.0), Eigen::Vector3d(3, 4, 0.5));
+  });
+  s.make(1e-4, 1e-3, 0.02, [](double) { return true; });
+  s.make_attitudes(1e-3, 1e-3);
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> N;
+  for (gt::AttitudeFix& a : s.attitudes)
+    a.q_enu_lidar = Eigen::Quaterniond(N(rng), N(rng), N(rng), N(rng)).normalized();
+  const gt::PoseGraphResult r = gt::solve_pose_graph(s.odometry, s.fixes, s.p_lidar_antenna,
+                                                     gt::PoseGraphConfig{}, s.attitudes);
+  ASSERT_EQ(r.T_enu_lidar.size(), s.truth.size());
+  EXPECT_EQ(r.attitudes_rejected, r.attitude_priors.size());
+  ASSERT_EQ(r.undetermined.size(), 1u);
+  EXPECT_NE(r.undetermined[0].why.find("Every GNSS/INS attitude was rejected"), std::string::npos)
+      << r.undetermined[0].why;
+  EXPECT_TRUE(r.covariance.empty());
+}
+
 TEST(PoseGraph, AStraightLineLeavesOnlyTheRollAboutItUndetermined) {
   Synthetic s;
   s.truth = truth_of(20, [](double t) {
@@ -341,6 +434,87 @@ TEST(PoseGraph, AStraightLineLeavesOnlyTheRollAboutItUndetermined) {
               0.03)
         << k;
   }
+}
+
+// The same line with a GNSS/INS's attitudes: the roll about it is theirs, nothing undetermined;
+// a few attitudes 5 deg off (an INS's glitch) are rejected by the gate, and only they.
+TEST(PoseGraph, AStraightLineHasItsRollFromTheInsAttitudes) {
+  Synthetic s;
+  s.truth = truth_of(20, [](double t) {
+    return SE3::from_rotation_vector(Eigen::Vector3d(0, 0, 0.5),
+                                     Eigen::Vector3d(std::cos(0.5) * t, std::sin(0.5) * t, 0));
+  });
+  s.make(1e-4, 1e-3, 0.02, [](double) { return true; });
+  s.make_attitudes(0.1 * M_PI / 180, 0.5 * M_PI / 180);
+  const std::set<size_t> glitches = {20, 77, 130, 180};
+  for (const size_t k : glitches) {
+    s.attitudes[k].q_enu_lidar =
+        Eigen::Quaterniond(
+            SE3::from_rotation_vector(Eigen::Vector3d(0.05, -0.06, 0.0), Eigen::Vector3d::Zero())
+                .R) *
+        s.attitudes[k].q_enu_lidar;
+  }
+  const gt::PoseGraphResult r = gt::solve_pose_graph(s.odometry, s.fixes, s.p_lidar_antenna,
+                                                     gt::PoseGraphConfig{}, s.attitudes);
+  ASSERT_EQ(r.T_enu_lidar.size(), s.truth.size());
+  EXPECT_TRUE(r.undetermined.empty()) << r.undetermined[0].what << ": " << r.undetermined[0].why;
+  ASSERT_EQ(r.covariance.size(), s.truth.size());
+  // Every glitch rejected; of the rest, what the gate's 99.9 % quantile lets through (0.2 of 197
+  // expected, 2 at most here).
+  std::set<size_t> rejected;
+  for (const gt::AttitudeResidual& a : r.attitude_priors)
+    if (a.rejected) rejected.insert(a.node);
+  for (const size_t k : glitches) EXPECT_EQ(rejected.count(k), 1u) << k;
+  EXPECT_LE(rejected.size(), glitches.size() + 2);
+  const Eigen::Vector3d line(std::cos(0.5), std::sin(0.5), 0);
+  double worst_roll_deg = 0;
+  for (size_t k = 0; k < s.truth.size(); ++k) {
+    const Eigen::Vector3d e =
+        rotation_vector(r.T_enu_lidar.T_world_body[k].R * s.truth.T_world_body[k].R.transpose());
+    worst_roll_deg = std::max(worst_roll_deg, std::abs(e.dot(line)) * 180 / M_PI);
+  }
+  const double roll_sigma_deg =
+      std::sqrt(line.dot(r.covariance[100].topLeftCorner<3, 3>() * line)) * 180 / M_PI;
+  std::printf(
+      "[ figures ] a straight line with attitudes: the roll about it %.4f deg at worst, its sigma "
+      "%.4f deg at the middle\n",
+      worst_roll_deg, roll_sigma_deg);
+  // Without them it is free (the test above: the odometry's frame is 57 deg off); with them
+  // about 0.1 deg of sigma (0.1 deg of tilt taken as correlated over 10 s, 20 s of them, and
+  // the odometry's rotation walking 0.006 deg a step).
+  EXPECT_LT(roll_sigma_deg, 0.15);
+  EXPECT_LT(worst_roll_deg, 0.3);
+  EXPECT_GE(rotations_within_3_sigma(r, s.truth), 0.95);
+}
+
+// The attitudes from GNSS/INS poses: the INS's rotation through the rig's; refused where there
+// is no attitude to take.
+TEST(PoseGraph, AttitudeFixesComposeTheRigsRotationAndRefusePositionsOnly) {
+  Trajectory T_enu_ins;
+  T_enu_ins.stamps = {Time::from_seconds(10.0), Time::from_seconds(10.01)};
+  T_enu_ins.T_world_body = {
+      SE3::from_rotation_vector(Eigen::Vector3d(0.1, 0.2, 1.5), Eigen::Vector3d(1, 2, 3)),
+      SE3::from_rotation_vector(Eigen::Vector3d(0.1, 0.2, 1.6), Eigen::Vector3d(1, 2, 3))};
+  const Eigen::Quaterniond q_ins_lidar(
+      SE3::from_rotation_vector(Eigen::Vector3d(M_PI, 0, 0.01), Eigen::Vector3d::Zero()).R);
+  const std::vector<gt::AttitudeFix> a =
+      gt::attitude_fixes(T_enu_ins, q_ins_lidar, 0.25, Eigen::Vector2d(0.001, 0.004));
+  ASSERT_EQ(a.size(), 2u);
+  EXPECT_EQ(a[1].stamp, Time::from_seconds(10.26));
+  EXPECT_LT((a[1].q_enu_lidar.toRotationMatrix() -
+             T_enu_ins.T_world_body[1].R * q_ins_lidar.toRotationMatrix())
+                .norm(),
+            1e-12);
+  EXPECT_NEAR(a[0].covariance(0, 0), 1e-6, 1e-18);
+  EXPECT_NEAR(a[0].covariance(2, 2), 1.6e-5, 1e-18);
+  for (SE3& T : T_enu_ins.T_world_body) T.R.setIdentity();
+  try {
+    gt::attitude_fixes(T_enu_ins, q_ins_lidar, 0.0, Eigen::Vector2d(0.001, 0.004));
+    ADD_FAILURE() << "identity rotations taken as attitudes";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("carry no attitude"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(gt::attitude_fixes(T_enu_ins, q_ins_lidar, 0.0, Eigen::Vector2d(0.0, 0.004)), Error);
 }
 
 // A walk along a line with a 0.7 m lateral sway (less than min_spread_m across it): the sway and
@@ -945,6 +1119,73 @@ TEST(GroundTruthCli, WritesVbrsFormatAndSigmasRefusesBadInputAndSaysWhatIsUndete
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("LAT,LON,HEIGHT"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "w_gt.txt"));
+
+  // The GNSS/INS poses' attitudes as priors (--attitude), with the simulator's INS noise as their
+  // sigmas (0.05 deg a fix on each axis, white): taken at every scan that has an attitude on
+  // each side, their residuals within that noise, and the rotations better than without them.
+  r = testing::rigcal_cli(common + fmt::format(" --odometry {0}/odom.tum --covariances {0}/c.txt "
+                                               "--gnss {0}/rec/poses.tum --attitude "
+                                               "{0}/rec/poses.tum --attitude-sigma-deg 0.05,0.05 "
+                                               "--attitude-correlation 0 --out {0}/a_gt.txt "
+                                               "--report {0}/a_report",
+                                               dir.string()),
+                          dir);
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("GNSS/INS attitudes: "), std::string::npos) << r.out;
+  EXPECT_EQ((r.out + r.err).find("attitude is not used"), std::string::npos) << r.out << r.err;
+  {
+    const nlohmann::json a =
+        nlohmann::json::parse(testing::slurp(dir / "a_report/ground_truth.json"));
+    const nlohmann::json& summary = a["summary"]["attitudes"];
+    EXPECT_GE(summary["priors"].get<size_t>(), s.truth_enu.size() - 2);
+    EXPECT_LE(summary["priors_rejected"].get<size_t>(), s.truth_enu.size() / 100);
+    EXPECT_EQ(a["attitude_priors"].size(), summary["priors"].get<size_t>());
+    // Two axes of 0.05 deg: 0.071 deg rms of tilt; one: 0.05 of heading.
+    EXPECT_LT(summary["residual_tilt_deg"]["rms"].get<double>(), 0.09);
+    EXPECT_LT(summary["residual_heading_deg"]["rms"].get<double>(), 0.065);
+    EXPECT_DOUBLE_EQ(summary["sigma_heading_deg"].get<double>(), 0.05);
+    EXPECT_NE(testing::slurp(dir / "a_report/report.html").find("GNSS/INS attitudes"),
+              std::string::npos);
+    const Trajectory with = io::read_trajectory(dir / "a_gt.txt").trajectory;
+    ASSERT_EQ(with.size(), gt.size());
+    std::vector<double> deg_with, deg_without;
+    for (size_t k = 0; k < gt.size(); ++k) {
+      const Eigen::Matrix3d& R_true = s.truth_enu.T_world_body[k].R;
+      deg_with.push_back(rotation_angle(with.T_world_body[k].R * R_true.transpose()) * 180 / M_PI);
+      deg_without.push_back(rotation_angle(gt.T_world_body[k].R * R_true.transpose()) * 180 / M_PI);
+    }
+    std::printf("[ figures ] rotation errors rms: %.4f deg with the attitudes, %.4f without\n",
+                rms(deg_with), rms(deg_without));
+    EXPECT_LT(rms(deg_with), 0.5 * rms(deg_without));
+  }
+  // Positions written as poses (every rotation the identity): refused, the file named.
+  Trajectory positions = s.part.gnss;
+  for (SE3& T : positions.T_world_body) T.R.setIdentity();
+  write(dir / "positions.tum", io::trajectory_to_tum(positions));
+  r = testing::rigcal_cli(common + fmt::format(" --odometry {0}/odom.tum --covariances {0}/c.txt "
+                                               "--gnss {0}/rec/poses.tum --attitude "
+                                               "{0}/positions.tum --out {0}/b_gt.txt",
+                                               dir.string()),
+                          dir);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("positions.tum: every rotation is the identity"), std::string::npos)
+      << r.err;
+  // A rig whose GNSS sensor is an antenna: no attitude to take.
+  {
+    std::string rig = testing::slurp(RIGCAL_SOURCE_DIR "/data/sample_rig.yaml");
+    const size_t at = rig.find("frame: ins");
+    ASSERT_NE(at, std::string::npos);
+    write(dir / "antenna.yaml", rig.replace(at, 10, "frame: antenna"));
+  }
+  r = testing::rigcal_cli(fmt::format("ground-truth {0}/rec --rig {0}/antenna.yaml --odometry "
+                                      "{0}/odom.tum --covariances {0}/c.txt --gnss "
+                                      "{0}/rec/poses.tum --attitude {0}/rec/poses.tum --out "
+                                      "{0}/b_gt.txt",
+                                      dir.string()),
+                          dir);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("a GNSS antenna"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "b_gt.txt"));
   fs::remove_all(dir);
 }
 
