@@ -48,7 +48,7 @@ build-fuzz: configure-fuzz
 
 # Every test but the long ones (CTest label "long"), within the CI budget of 20 minutes on 2
 # cores: the gcc build's tests, then the format readers under the sanitizers (their fuzz targets'
-# committed inputs replayed, then 5 s of fuzzing each).
+# committed inputs replayed, then 3 s of fuzzing each).
 test: test-fast $(if $(filter 1,$(SANITIZE)),test-fuzz)
 
 # The gcc build's tests only.

@@ -75,7 +75,8 @@ inline std::pair<double, double> ate_enu(const Trajectory& estimate, const Traje
 }
 
 // `config_yaml`: the simulator's settings on top of the ground-truth part's defaults;
-// `gt_args`: more options of `rigcal ground-truth`.
+// `gt_args`: more options of `rigcal ground-truth`, in which `@rec` stands for the simulated
+// recording's folder (`--attitude @rec/trajectories/gnss_ins.tum`).
 inline GroundTruthScore simulated_ground_truth(const std::filesystem::path& dir, uint64_t seed,
                                                const std::string& config_yaml,
                                                const std::string& gt_args = "",
@@ -107,7 +108,10 @@ inline GroundTruthScore simulated_ground_truth(const std::filesystem::path& dir,
       fmt::format("--gnss {}/trajectories/gnss_fixes.csv --enu-origin {},{},{}", rec.string(),
                   origin["latitude_deg"].get<double>(), origin["longitude_deg"].get<double>(),
                   origin["height_m"].get<double>());
-  std::string args = gt_args;
+  std::string extra = gt_args;
+  for (size_t at = extra.find("@rec"); at != std::string::npos; at = extra.find("@rec", at))
+    extra.replace(at, 4, rec.string());
+  std::string args = extra;
   if (stages) {
     // rigcal's odometry once, for every stage.
     const CliRun odometry = rigcal_cli(
@@ -126,7 +130,7 @@ inline GroundTruthScore simulated_ground_truth(const std::filesystem::path& dir,
     const CliRun bound =
         rigcal_cli(fmt::format("ground-truth {0} --rig {0}/truth.yaml {3} --out {1}/exact_gt.txt "
                                "--odometry {1}/exact.tum --no-bundle-adjustment {2}",
-                               rec.string(), dir.string(), gt_args, gnss_input),
+                               rec.string(), dir.string(), extra, gnss_input),
                    dir);
     if (failed(bound)) return s;
     const CliRun stage1 =
