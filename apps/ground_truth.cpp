@@ -80,10 +80,10 @@ void add_ground_truth(CLI::App& app) {
                   "path")
       ->check(CLI::ExistingFile);
   cmd->add_option("--attitude-sigma-deg", o->attitude_sigma_deg,
-                  "TILT,HEADING: the attitudes' sigmas, deg (roll and pitch; heading)")
+                  "TILT,HEADING: the attitudes' sigmas, deg (roll and pitch; heading; default "
+                  "0.1,0.5, conservative for an RTK INS: give the receiver's own)")
       ->delimiter(',')
-      ->check(CLI::Range(1e-6, 180.0))
-      ->capture_default_str();
+      ->check(CLI::Range(1e-6, 180.0));
   cmd->add_option("--attitude-correlation", o->step.pose_graph.attitude_correlation_s,
                   "the attitudes' error correlation time, s: each prior weighs as 1 / (2 S x scan "
                   "rate) of an independent one (0: independent)")

@@ -297,8 +297,13 @@ TEST(BenchPeers, EvoTimeWindowsOffsetsAndDeltaUnitsToOneBillionth) {
 
 // The official VBR evaluator (vbr_benchmark.cpp at 4481695, built here with Debian's Eigen and
 // its figures printed to 17 digits) on 100,000 poses of the synthetic drive, written as TUM files:
-// rigcal's vbr convention gives its figures to the last bit. (Summed in float, as rigcal did
-// before, the RPE was 3.1e-4 off here and 1.7 % at a million poses: the evaluator sums in double.)
+// rigcal's vbr convention gives its RPE to the last bit. (Summed in float, as rigcal did before,
+// the RPE was 3.1e-4 off here and 1.7 % at a million poses: the evaluator sums in double.) Its ATE
+// comes from Eigen's umeyama in float, whose 100,000-point product Eigen blocks by the CPU's cache
+// sizes (read at run time): the evaluator itself gives another last bit on another CPU (measured:
+// 3.9e-5 relative in translation, 2.1e-6 in rotation, on an AMD EPYC against the machine these
+// figures were made on; the same float umeyama with other cache sizes set through
+// Eigen::setCpuCacheSizes changes too). The ATE is held to 2e-4 of the evaluator's figures.
 TEST(BenchPeers, VbrEvaluatorOnAHundredThousandPosesToTheLastBit) {
   const auto [gt_mem, est_mem] = testing::synthetic_drive(100'000);
   EvalOptions o;
@@ -311,8 +316,8 @@ TEST(BenchPeers, VbrEvaluatorOnAHundredThousandPosesToTheLastBit) {
   EXPECT_EQ(rpe->drift.n_segments, 758'000u);
   EXPECT_REL(rpe->drift.trans_pct, 0.37482549081903149, 1e-15);
   EXPECT_REL(rpe->drift.rot_deg_per_m, 2.8592847629861027e-4, 1e-15);
-  EXPECT_REL(*r.vbr_ate_trans, 2.8916838796376241, 1e-15);
-  EXPECT_REL(*r.vbr_ate_rot, 1.0731830328837499, 1e-15);
+  EXPECT_REL(*r.vbr_ate_trans, 2.8916838796376241, 2e-4);
+  EXPECT_REL(*r.vbr_ate_rot, 1.0731830328837499, 2e-4);
 }
 
 // Stamps since the UNIX epoch: the evaluator's float stamps are 128 s apart near 1.7e9 s and it
