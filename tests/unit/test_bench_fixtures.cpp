@@ -410,10 +410,13 @@ TEST(BenchPeers, VbrEvaluatorLeaderboardOfLoamOnSixSequences) {
     ASSERT_TRUE(e.ok) << e.problem;
     // 2 of the 18 figures are past half a unit of the sixth digit, by 6.2e-8 relative at most:
     // the rounding of the LOAM files' quaternions, which the evaluator builds its rotations from
-    // without normalising them.
+    // without normalising them. The ATE's alignment is the evaluator's float umeyama, whose
+    // product Eigen blocks by the CPU's cache sizes: on an AMD EPYC spagna's ATE is 2.7e-6
+    // relative off the printed figure (VbrEvaluatorOnAHundredThousandPosesToTheLastBit says
+    // more), so the ATE is held to 1e-5.
     EXPECT_PRINTED(e.rpe_pct, rows[s].rpe_t, 1e-7);
     EXPECT_PRINTED(e.rpe_rot, rows[s].rpe_r, 1e-7);
-    EXPECT_PRINTED(e.ate, rows[s].ate_t, 1e-7);
+    EXPECT_PRINTED(e.ate, rows[s].ate_t, 1e-5);
   }
   EXPECT_SIX_DIGITS(board.rows[0].rpe_rank, 26.1278);
   EXPECT_SIX_DIGITS(board.rows[0].ate_rank, 52.2728);
