@@ -5,9 +5,7 @@
 #include <memory>
 
 #include "cli.h"
-#include "rigcal/core/text.h"
 #include "rigcal/gt/step.h"
-#include "rigcal/io/files.h"
 #include "step_output.h"
 
 namespace rigcal::cli {
@@ -17,25 +15,13 @@ namespace fs = std::filesystem;
 struct Options {
   gt::InputFiles in;
   gt::StepOptions step;
-  std::string out, sigmas, report, map, enu_origin, fix_correlation = "auto", fix_model = "states";
-  bool no_bundle_adjustment = false, no_fusion = false;
-  std::pair<size_t, size_t> windows{0, 0};  // FROM:TO; 0:0 all
-  std::pair<double, double> attitude_sigma_deg{gt::StepOptions{}.attitude_sigma_deg.x(),
-                                               gt::StepOptions{}.attitude_sigma_deg.y()};
+  gt::CommandWords words;
+  std::string out, sigmas, report, map;
 };
 
 void run(Options o) {
-  o.step.bundle_adjustment = !o.no_bundle_adjustment;
-  o.step.fuse_odometry = !o.no_fusion;
-  o.step.attitude_sigma_deg = {o.attitude_sigma_deg.first, o.attitude_sigma_deg.second};
-  o.step.map = !o.map.empty();
-  if (!o.enu_origin.empty())
-    o.step.enu_origin = io::parse_geodetic_origin(o.enu_origin, "--enu-origin");
-  o.step.pose_graph.fix_correlation_s =
-      o.fix_correlation == "auto" ? -1.0 : parse_double(o.fix_correlation, "--fix-correlation");
-  o.step.pose_graph.fix_error_states = o.fix_model == "states";
-  if (o.windows != std::pair<size_t, size_t>{0, 0})
-    std::tie(o.step.ba.first_window, o.step.ba.end_window) = o.windows;
+  o.words.map = !o.map.empty();
+  gt::apply_command_words(o.words, o.step);
   const gt::CommandOutcome r =
       gt::ground_truth_command(o.in, o.step, o.out, o.sigmas, o.report, o.map, console_progress());
   fmt::print("{}", r.text);
@@ -74,12 +60,10 @@ void add_ground_truth(CLI::App& app) {
                   "its step covariances (default: ODOMETRY without extension + _covariances.txt)");
   cmd->add_option("--gnss", o->in.gnss, "GNSS/INS poses (TUM, T_enu_gnss) or fixes (CSV)");
   cmd->add_option("--attitude", o->in.attitude,
-                  "GNSS/INS poses (T_enu_ins, any trajectory format; may be --gnss itself) whose "
-                  "rotations become priors on the LiDAR's, through the rig's INS-to-LiDAR "
-                  "rotation: they settle a standing rig's heading and the roll about a straight "
-                  "path")
+                  "GNSS/INS poses (T_enu_ins; may be --gnss) whose rotations are priors on the "
+                  "LiDAR's (a standing rig's heading, a straight path's roll)")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--attitude-sigma-deg", o->attitude_sigma_deg,
+  cmd->add_option("--attitude-sigma-deg", o->words.attitude_sigma_deg,
                   "TILT,HEADING: the attitudes' sigmas, deg (roll and pitch; heading; default "
                   "0.1,0.5, conservative for an RTK INS: give the receiver's own)")
       ->delimiter(',')
@@ -91,7 +75,7 @@ void add_ground_truth(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--gnss-sensor", o->step.gnss_sensor, "the rig's GNSS sensor")
       ->capture_default_str();
-  cmd->add_option("--enu-origin", o->enu_origin,
+  cmd->add_option("--enu-origin", o->words.enu_origin,
                   "LAT,LON,HEIGHT (degrees, degrees, ellipsoidal m): the fixes' ENU frame at this "
                   "origin instead of at the first fix (sessions that must share one frame; fixes "
                   "only, not GNSS/INS poses)");
@@ -103,12 +87,12 @@ void add_ground_truth(CLI::App& app) {
                   "apart, s")
       ->check(seconds_within(1e-6, 60))
       ->capture_default_str();
-  cmd->add_option("--fix-correlation", o->fix_correlation,
+  cmd->add_option("--fix-correlation", o->words.fix_correlation,
                   "the fixes' error correlation time S, s (0: independent; auto: estimated from "
                   "the residuals of the solves, each solved again with it until it settles)")
       ->check(CLI::IsMember({"auto"}) | seconds_within(0, 600))
       ->capture_default_str();
-  cmd->add_option("--fix-model", o->fix_model,
+  cmd->add_option("--fix-model", o->words.fix_model,
                   "how correlated fixes weigh: states (their error a Gauss-Markov state of "
                   "correlation time S at every scan, in units of each fix's sigmas, part of its "
                   "variance white: with --fix-correlation auto, S and that part the most likely, "
@@ -118,9 +102,9 @@ void add_ground_truth(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--scans", o->in.scans,
                   "the scans (a folder, a capture, a recording; default: the recording's)");
-  cmd->add_flag("--no-bundle-adjustment", o->no_bundle_adjustment,
+  cmd->add_flag("--no-bundle-adjustment", o->words.no_bundle_adjustment,
                 "stop at the pose graph (stage 1)");
-  cmd->add_flag("--no-fusion", o->no_fusion,
+  cmd->add_flag("--no-fusion", o->words.no_fusion,
                 "take the bundle adjustment's motions alone into the second pose graph (default: "
                 "each fused with the odometry's by covariance intersection where the two agree "
                 "within their covariances)");
@@ -135,7 +119,7 @@ void add_ground_truth(CLI::App& app) {
                   "scans each window shares with the previous one")
       ->check(CLI::Range(size_t(0), size_t(999)))
       ->capture_default_str();
-  cmd->add_option("--windows", o->windows,
+  cmd->add_option("--windows", o->words.windows,
                   "FROM:TO: adjust only the windows FROM to TO - 1 (numbered from 0) and write "
                   "the motions they own to OUT (TUM) and OUT's _covariances.txt, nothing else: "
                   "one task of a job array (the same odometry, GNSS and options in every task)")

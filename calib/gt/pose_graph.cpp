@@ -475,10 +475,7 @@ std::vector<AttitudeFix> attitude_fixes(const Trajectory& T_enu_ins,
     throw Error(
         "every rotation is the identity: positions written as poses carry no attitude (give the "
         "GNSS/INS's own poses, or no attitudes)");
-  const Eigen::Matrix3d covariance =
-      Eigen::Vector3d(sigma_rad.x() * sigma_rad.x(), sigma_rad.x() * sigma_rad.x(),
-                      sigma_rad.y() * sigma_rad.y())
-          .asDiagonal();
+  const Eigen::Matrix3d covariance = covariance_of(sigma_rad);  // tilt on two axes, as horizontal
   std::vector<AttitudeFix> out;
   out.reserve(T_enu_ins.size());
   const Time offset = Time::from_seconds(time_offset_s);
@@ -571,18 +568,15 @@ PoseGraphResult solve_pose_graph(const OdometryInput& odometry,
   // solved, and the rotation about the line judged by its marginal sigma below.
   bool hold_rotation = spread_axes == 0 && attitude_priors.empty();
   // Priors closer in time than the fixes' correlation share their error.
-  double prior_scale = 1.0;
-  if (config.fix_correlation_s > 0 && n >= 2) {
-    const double scan_rate = double(n - 1) / (scans.stamps.back() - scans.stamps.front()).seconds();
-    // A first-order Gauss-Markov error of correlation time tau averages over a span T as
-    // T / (2 tau) independent samples would.
-    prior_scale = std::max(1.0, 2.0 * config.fix_correlation_s * scan_rate);
-  }
-  double attitude_scale = 1.0;
-  if (config.attitude_correlation_s > 0 && n >= 2) {
-    const double scan_rate = double(n - 1) / (scans.stamps.back() - scans.stamps.front()).seconds();
-    attitude_scale = std::max(1.0, 2.0 * config.attitude_correlation_s * scan_rate);
-  }
+  // A first-order Gauss-Markov error of correlation time tau averages over a span T as
+  // T / (2 tau) independent samples would: each prior's covariance scaled by the scans in 2 tau.
+  const double scan_rate =
+      n >= 2 ? double(n - 1) / (scans.stamps.back() - scans.stamps.front()).seconds() : 0.0;
+  auto correlation_scale = [&](double tau_s) {
+    return tau_s > 0 && n >= 2 ? std::max(1.0, 2.0 * tau_s * scan_rate) : 1.0;
+  };
+  const double prior_scale = correlation_scale(config.fix_correlation_s);
+  const double attitude_scale = correlation_scale(config.attitude_correlation_s);
   out.attitude_priors.resize(attitude_priors.size());
   for (size_t j = 0; j < attitude_priors.size(); ++j) {
     out.attitude_priors[j].fix = attitude_priors[j].fix;

@@ -696,6 +696,19 @@ StepInputs step_inputs(const InputFiles& files, const StepOptions& options,
   return in;
 }
 
+void apply_command_words(const CommandWords& w, StepOptions& o) {
+  o.bundle_adjustment = !w.no_bundle_adjustment;
+  o.fuse_odometry = !w.no_fusion;
+  o.map = w.map;
+  o.attitude_sigma_deg = {w.attitude_sigma_deg.first, w.attitude_sigma_deg.second};
+  if (!w.enu_origin.empty()) o.enu_origin = io::parse_geodetic_origin(w.enu_origin, "--enu-origin");
+  o.pose_graph.fix_correlation_s =
+      w.fix_correlation == "auto" ? -1.0 : parse_double(w.fix_correlation, "--fix-correlation");
+  o.pose_graph.fix_error_states = w.fix_model == "states";
+  if (w.windows != std::pair<size_t, size_t>{0, 0})
+    std::tie(o.ba.first_window, o.ba.end_window) = w.windows;
+}
+
 GroundTruthPaths ground_truth_paths(const fs::path& out, const fs::path& sigmas,
                                     const fs::path& report_dir, const fs::path& map,
                                     const StepInputs& in) {

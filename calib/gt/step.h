@@ -173,6 +173,17 @@ GroundTruthPaths ground_truth_paths(const std::filesystem::path& out,
                                     const std::filesystem::path& report_dir,
                                     const std::filesystem::path& map, const StepInputs& inputs);
 
+// The command line's words for what StepOptions holds as values (`rigcal ground-truth`'s
+// options): set into `options`; throws rigcal::Error naming the option on a bad number or origin.
+struct CommandWords {
+  std::string enu_origin, fix_correlation = "auto", fix_model = "states";
+  bool no_bundle_adjustment = false, no_fusion = false, map = false;
+  std::pair<size_t, size_t> windows{0, 0};  // FROM:TO; 0:0 all
+  std::pair<double, double> attitude_sigma_deg{StepOptions{}.attitude_sigma_deg.x(),
+                                               StepOptions{}.attitude_sigma_deg.y()};
+};
+void apply_command_words(const CommandWords& words, StepOptions& options);
+
 // A whole `rigcal ground-truth` run: the inputs read, the run, its files written (all or none),
 // and what it says: `text` for stdout, `undetermined` lines for stderr, the exit status (0, or 3
 // when the fixes leave something undetermined or place no pose). Throws as step_inputs,
