@@ -112,11 +112,18 @@ void add_ground_truth(CLI::App& app) {
                 "add the photometric term to each window (range and intensity between the "
                 "scans' spherical images, after the geometric rounds; doc/ground-truth.md "
                 "measures what it adds)");
-  cmd->add_option("--window-scans", o->step.ba.window_scans, "scans a bundle-adjustment window")
+  cmd->add_option("--keyframes", o->words.keyframes,
+                  "M,DEG: experimental, not for use: a scan is a keyframe of the bundle "
+                  "adjustment once the rig moved M metres or turned DEG degrees since the last "
+                  "(default 0,0: every scan); 0.3,5 halves a walk's time and fails where the "
+                  "scene holds the motion poorly (doc/ground-truth.md, \"Keyframes\")")
+      ->delimiter(',')
+      ->check(CLI::Range(0.0, 1000.0));
+  cmd->add_option("--window-scans", o->step.ba.window_scans, "keyframes a bundle-adjustment window")
       ->check(CLI::Range(size_t(2), size_t(1000)))
       ->capture_default_str();
   cmd->add_option("--window-overlap", o->step.ba.overlap_scans,
-                  "scans each window shares with the previous one")
+                  "keyframes each window shares with the previous one")
       ->check(CLI::Range(size_t(0), size_t(999)))
       ->capture_default_str();
   cmd->add_option("--windows", o->words.windows,

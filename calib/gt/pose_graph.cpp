@@ -21,18 +21,6 @@
 namespace rigcal::gt {
 namespace {
 
-// U with U' U = covariance^-1; directions of (numerically) zero variance get a large but finite
-// weight rather than an infinite one.
-template <int N>
-Eigen::Matrix<double, N, N> sqrt_information(const Eigen::Matrix<double, N, N>& covariance) {
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, N, N>> eigen(covariance);
-  const double largest = std::max(eigen.eigenvalues().maxCoeff(), 1e-300);
-  Eigen::Matrix<double, N, 1> inv_sqrt;
-  for (int i = 0; i < N; ++i)
-    inv_sqrt(i) = 1.0 / std::sqrt(std::max(eigen.eigenvalues()(i), 1e-16 * largest));
-  return inv_sqrt.asDiagonal() * eigen.eigenvectors().transpose();
-}
-
 Eigen::Matrix3d covariance_of(const Eigen::Vector2d& sigma_h_v) {
   return Eigen::Vector3d(sigma_h_v.x() * sigma_h_v.x(), sigma_h_v.x() * sigma_h_v.x(),
                          sigma_h_v.y() * sigma_h_v.y())

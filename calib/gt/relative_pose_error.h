@@ -38,4 +38,14 @@ struct RelativePoseError {
   }
 };
 
+// The same term on the bundle adjustment's knots (a quaternion x y z w, then the translation, in
+// one block): a window's motion across a gap between keyframes against the odometry's.
+struct KnotMotionError {
+  RelativePoseError error;
+  template <class T>
+  bool operator()(const T* knot_prev, const T* knot_cur, T* residual) const {
+    return error(knot_prev, knot_prev + 4, knot_cur, knot_cur + 4, residual);
+  }
+};
+
 }  // namespace rigcal::gt

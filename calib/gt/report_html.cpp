@@ -87,9 +87,11 @@ std::string bundle_section(const json& b) {
   std::string out = "<h2 id=\"bundle\">LiDAR bundle adjustment</h2>\n";
   if (b["point_plane_rms_before_m"].is_object()) {
     out += fmt::format(
-        "<p>{} windows in {} s. Points off their planes (RMS, median over the windows): {} mm "
-        "before, {} mm after; the poses moved {} mm and {} deg (RMS) from the pose graph's.</p>\n",
-        html_number(b["windows"], "{:.0f}"), html_number(b["seconds"], "{:.1f}"),
+        "<p>{} windows of {} keyframes in {} s. Points off their planes (RMS, median over the "
+        "windows): {} mm before, {} mm after; the poses moved {} mm and {} deg (RMS) from the pose "
+        "graph's.</p>\n",
+        html_number(b["windows"], "{:.0f}"), html_number(b.value("keyframes", json()), "{:.0f}"),
+        html_number(b["seconds"], "{:.1f}"),
         html_number(b["point_plane_rms_before_m"]["median"], "{:.2f}", 1e3),
         html_number(b["point_plane_rms_after_m"]["median"], "{:.2f}", 1e3),
         html_number(b["pose_change_from_stage1_m"]["rms"], "{:.1f}", 1e3),

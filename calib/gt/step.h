@@ -181,6 +181,8 @@ struct CommandWords {
   std::pair<size_t, size_t> windows{0, 0};  // FROM:TO; 0:0 all
   std::pair<double, double> attitude_sigma_deg{StepOptions{}.attitude_sigma_deg.x(),
                                                StepOptions{}.attitude_sigma_deg.y()};
+  std::pair<double, double> keyframes{StepOptions{}.ba.keyframe_distance_m,
+                                      StepOptions{}.ba.keyframe_angle_deg};  // M,DEG
 };
 void apply_command_words(const CommandWords& words, StepOptions& options);
 

@@ -3,7 +3,10 @@
 // relative motions with their covariances, GNSS position fixes with theirs, and the poses the
 // pose graph puts in the local ENU frame of the fixes, each with its covariance.
 #include <Eigen/Core>
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -15,6 +18,18 @@
 namespace rigcal::gt {
 
 using Matrix6d = Eigen::Matrix<double, 6, 6>;
+
+// U with U' U = covariance^-1 (an error term's weight); directions of (numerically) zero variance
+// get a large but finite weight rather than an infinite one.
+template <int N>
+Eigen::Matrix<double, N, N> sqrt_information(const Eigen::Matrix<double, N, N>& covariance) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, N, N>> eigen(covariance);
+  const double largest = std::max(eigen.eigenvalues().maxCoeff(), 1e-300);
+  Eigen::Matrix<double, N, 1> inv_sqrt;
+  for (int i = 0; i < N; ++i)
+    inv_sqrt(i) = 1.0 / std::sqrt(std::max(eigen.eigenvalues()(i), 1e-16 * largest));
+  return inv_sqrt.asDiagonal() * eigen.eigenvectors().transpose();
+}
 
 // What the receiver says of a fix. The sigmas a quality stands for when the receiver gives none
 // are PoseGraphConfig's.

@@ -14,6 +14,7 @@
 #include "rigcal/core/error.h"
 #include "rigcal/gt/photometric_error.h"
 #include "rigcal/gt/point_to_plane_error.h"
+#include "rigcal/gt/relative_pose_error.h"
 #include "rigcal/gt/sweep_point_to_plane_error.h"
 #include "rigcal/lidar/preprocess.h"
 
@@ -148,17 +149,17 @@ void solve_knots(ceres::Problem& problem, std::vector<Eigen::Vector4d>& plane, s
                 "solve failed: " + summary.message);
 }
 
-// The motion's covariance between consecutive scan knots (`scan_knots`, indices into the internal
-// knots): the information of the knots from the last solve's Jacobian, the planes eliminated
-// (each plane's 3 x 3 block, its Schur complement onto the knots it touches), inverted with the
-// held first knot left out. A knot's tangent (KnotManifold) is half the rotation vector (exp(2 d)
-// R, on the left, in the world frame), then the world's translation. With the knots perturbed so
-// (phi, dt), the motion R_a' R_b, R_a' (t_b - t_a) is perturbed by e_rot = R_a' (phi_b - phi_a)
-// and e_t = R_a' (dt_b - dt_a) + R_a' [t_b - t_a]x phi_a, to first order. Empty when a knot has
-// no residual or the information is singular.
+// The motion's covariance between consecutive knots of `pose_knots` (indices into the internal
+// knots): the information of the knots from the last solve's Jacobian, the planes
+// eliminated (each plane's 3 x 3 block, its Schur complement onto the knots it touches), inverted
+// with the held first knot left out. A knot's tangent (KnotManifold) is half the rotation vector
+// (exp(2 d) R, on the left, in the world frame), then the world's translation. With the knots
+// perturbed so (phi, dt), the motion R_a' R_b, R_a' (t_b - t_a) is perturbed by e_rot = R_a' (phi_b
+// - phi_a) and e_t = R_a' (dt_b - dt_a) + R_a' [t_b - t_a]x phi_a, to first order. Empty when a
+// knot has no residual or the information is singular.
 std::vector<Matrix6d> step_covariances(ceres::Problem& problem, std::vector<Knot>& x,
                                        const std::vector<Eigen::Vector4d*>& planes,
-                                       const std::vector<size_t>& scan_knots, double scale) {
+                                       const std::vector<size_t>& pose_knots, double scale) {
   const size_t free_knots = x.size() - 1;  // knot 0 is held
   ceres::Problem::EvaluateOptions options;
   for (size_t k = 1; k < x.size(); ++k) {
@@ -217,8 +218,8 @@ std::vector<Matrix6d> step_covariances(ceres::Problem& problem, std::vector<Knot
     return C.block<6, 6>(6 * Eigen::Index(i - 1), 6 * Eigen::Index(j - 1));
   };
   std::vector<Matrix6d> out;
-  for (size_t k = 0; k + 1 < scan_knots.size(); ++k) {
-    const size_t a = scan_knots[k], b = scan_knots[k + 1];
+  for (size_t k = 0; k + 1 < pose_knots.size(); ++k) {
+    const size_t a = pose_knots[k], b = pose_knots[k + 1];
     Eigen::Matrix<double, 12, 12> joint;
     joint << block(a, a), block(a, b), block(b, a), block(b, b);
     const Eigen::Matrix3d Rt = knot_pose(x[a]).R.transpose();
@@ -338,40 +339,62 @@ void add_photometric(ceres::Problem& problem, const std::vector<ScanPoints>& den
 
 }  // namespace
 
-WindowBaResult window_ba(const std::vector<Scan>& scans, const std::vector<SE3>& T_world_lidar,
-                         Time end, const WindowBaConfig& config) {
-  if (T_world_lidar.size() != scans.size() + 1)
-    throw Error("window bundle adjustment: one knot a scan and one at the end are needed");
+WindowBaResult window_ba(const std::vector<Scan>& scans, const std::vector<Time>& stamps,
+                         const std::vector<SE3>& T_world_lidar, const WindowBaConfig& config,
+                         const std::vector<MotionPrior>& priors) {
+  if (T_world_lidar.size() != stamps.size())
+    throw Error("window bundle adjustment: one pose a stamp is needed");
+  for (size_t p = 1; p < stamps.size(); ++p)
+    if (!(stamps[p] > stamps[p - 1]))
+      throw Error("window bundle adjustment: the poses' stamps must increase");
+  // Each scan's pose (its sweep ends at the next pose); every pose a scan's stamp or the end of
+  // the sweep before it.
+  std::vector<size_t> scan_pose(scans.size());
+  std::vector<bool> starts_scan(stamps.size(), false);
   for (size_t k = 0; k < scans.size(); ++k) {
-    const Time next = k + 1 < scans.size() ? scans[k + 1].stamp : end;
-    if (!(next > scans[k].stamp))
-      throw Error("window bundle adjustment: the scans' stamps and the end must increase");
+    const auto it = std::lower_bound(stamps.begin(), stamps.end(), scans[k].stamp);
+    if (it == stamps.end() || *it != scans[k].stamp || it + 1 == stamps.end() ||
+        (k > 0 && size_t(it - stamps.begin()) <= scan_pose[k - 1]))
+      throw Error(
+          "window bundle adjustment: each scan, in time order, needs a pose at its stamp and one "
+          "after it (its sweep's end)");
+    scan_pose[k] = size_t(it - stamps.begin());
+    starts_scan[scan_pose[k]] = true;
   }
+  for (size_t p = 0; p < stamps.size(); ++p)
+    if (!starts_scan[p] && (p == 0 || !starts_scan[p - 1]))
+      throw Error(
+          "window bundle adjustment: a pose that is neither a scan's stamp nor the end of a sweep");
+  for (const MotionPrior& prior : priors)
+    if (prior.pose + 1 >= stamps.size())
+      throw Error("window bundle adjustment: a motion prior past the window's last pose");
   WindowBaResult out;
   out.T_world_lidar = T_world_lidar;
   if (scans.size() < 2) return out;
-  // The internal knots: m a sweep, the scans' knots every m-th, those between them started on
-  // the interpolation of the scans' knots.
+  // The internal knots: m a sweep, each pose's first, those within a sweep started on the
+  // interpolation of its two poses; a pose that starts no sweep (an end) is one knot.
   const size_t m = config.sweep_motion ? std::max(1, config.knots_per_sweep) : 1;
   std::vector<SE3> T_world_knot;
-  std::vector<size_t> scan_knot;
-  for (size_t k = 0; k < scans.size(); ++k) {
-    scan_knot.push_back(T_world_knot.size());
-    const SE3 T_a_b = T_world_lidar[k].inverse() * T_world_lidar[k + 1];
+  std::vector<size_t> pose_knot, scan_knot;
+  for (size_t p = 0; p < stamps.size(); ++p) {
+    pose_knot.push_back(T_world_knot.size());
+    if (!starts_scan[p]) {
+      T_world_knot.push_back(T_world_lidar[p]);
+      continue;
+    }
+    const SE3 T_a_b = T_world_lidar[p].inverse() * T_world_lidar[p + 1];
     for (size_t j = 0; j < m; ++j)
-      T_world_knot.push_back(T_world_lidar[k] *
+      T_world_knot.push_back(T_world_lidar[p] *
                              lidar::motion_fraction(T_a_b, double(j) / double(m)));
   }
-  scan_knot.push_back(T_world_knot.size());
-  T_world_knot.push_back(T_world_lidar.back());
+  for (size_t k = 0; k < scans.size(); ++k) scan_knot.push_back(pose_knot[scan_pose[k]]);
 
   // Each point with its knot and fraction: the voxel samples the adjustment uses (`points`) and,
   // for the photometric term's images, every point in range (`dense`).
   const bool photometric = config.photometric.enabled;
   std::vector<ScanPoints> points(scans.size()), dense(photometric ? scans.size() : 0);
   for (size_t k = 0; k < scans.size(); ++k) {
-    const Time next = k + 1 < scans.size() ? scans[k + 1].stamp : end;
-    const double span_ns = double((next - scans[k].stamp).ns);
+    const double span_ns = double((stamps[scan_pose[k] + 1] - scans[k].stamp).ns);
     const bool timed = config.sweep_motion && scans[k].point_times;
     auto sweep_point = [&](const ScanPoint& p) {
       const double f = timed ? std::clamp(double(p.t_ns) / span_ns, 0.0, 1.0) * double(m) : 0.0;
@@ -440,6 +463,13 @@ WindowBaResult window_ba(const std::vector<Scan>& scans, const std::vector<SE3>&
             x[k].data(), x[k + 1].data(), plane[j].data());
       }
     }
+    for (const MotionPrior& prior : priors) {
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<KnotMotionError, 6, 7, 7>(
+              new KnotMotionError{{prior.T_pose_next.quaternion(), prior.T_pose_next.t,
+                                   sqrt_information<6>(prior.covariance)}}),
+          nullptr, x[pose_knot[prior.pose]].data(), x[pose_knot[prior.pose + 1]].data());
+    }
     for (size_t j = 0; j < a.planes.size(); ++j) {
       problem.SetManifold(
           plane[j].data(),
@@ -460,7 +490,7 @@ WindowBaResult window_ba(const std::vector<Scan>& scans, const std::vector<SE3>&
                         10.0 * rotation_angle(T.R * T_world_knot[k].R.transpose())});
       T_world_knot[k] = T;
     }
-    for (size_t k = 0; k < scan_knot.size(); ++k) out.T_world_lidar[k] = T_world_knot[scan_knot[k]];
+    for (size_t p = 0; p < pose_knot.size(); ++p) out.T_world_lidar[p] = T_world_knot[pose_knot[p]];
     out.patches = a.planes.size();
     out.residuals = a.points.size();
     if (moved < config.converged_m) break;
@@ -476,19 +506,31 @@ WindowBaResult window_ba(const std::vector<Scan>& scans, const std::vector<SE3>&
     solve_knots(*last, plane, x, config.photometric.iterations, config, "photometric ");
     for (size_t k = 1; k < knots; ++k)
       if (last->HasParameterBlock(x[k].data())) T_world_knot[k] = knot_pose(x[k]);
-    for (size_t k = 0; k < scan_knot.size(); ++k) out.T_world_lidar[k] = T_world_knot[scan_knot[k]];
+    for (size_t p = 0; p < pose_knot.size(); ++p) out.T_world_lidar[p] = T_world_knot[pose_knot[p]];
   }
   const auto world = placed(points, T_world_knot);
   out.rms_after_m = rms_distance(associate(world, config), world);
   if (config.step_covariances && last) {
     const double variance = std::pow(out.rms_after_m / config.point_sigma_m, 2);
+    std::vector<size_t> scan_and_end_knots = scan_knot;
+    scan_and_end_knots.push_back(pose_knot.back());
     std::vector<Eigen::Vector4d*> plane_blocks;
     for (Eigen::Vector4d& p : plane)
       if (last->HasParameterBlock(p.data())) plane_blocks.push_back(&p);
     out.step_covariance =
-        step_covariances(*last, x, plane_blocks, scan_knot, std::max(1.0, variance));
+        step_covariances(*last, x, plane_blocks, scan_and_end_knots, std::max(1.0, variance));
   }
   return out;
+}
+
+WindowBaResult window_ba(const std::vector<Scan>& scans, const std::vector<SE3>& T_world_lidar,
+                         Time end, const WindowBaConfig& config) {
+  std::vector<Time> stamps;
+  for (const Scan& scan : scans) stamps.push_back(scan.stamp);
+  stamps.push_back(end);
+  if (T_world_lidar.size() != stamps.size())
+    throw Error("window bundle adjustment: one knot a scan and one at the end are needed");
+  return window_ba(scans, stamps, T_world_lidar, config);
 }
 
 }  // namespace rigcal::gt

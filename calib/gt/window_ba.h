@@ -9,10 +9,11 @@
 // pose graph.
 //
 // The sensor moves during a sweep: the poses are knots, one at each scan's stamp and one at the
-// end of the last sweep, and a point measured a fraction f of the way from its scan's stamp to
-// the next knot is placed by the interpolation of the two knots (sweep_point_to_plane_error.h).
-// The sweeps are deskewed by the adjustment itself, with the motion it estimates, and each
-// sweep's motion is its own (not the constant motion of the odometry's deskew).
+// end of each sweep the next scan does not start, and a point measured a fraction f of the way from
+// its scan's stamp to the next knot is placed by the interpolation of the two knots
+// (sweep_point_to_plane_error.h). The sweeps are deskewed by the adjustment itself, with the motion
+// it estimates, and each sweep's motion is its own (not the constant motion of the odometry's
+// deskew).
 #include <Eigen/Core>
 #include <vector>
 
@@ -77,17 +78,19 @@ struct WindowBaConfig {
 };
 
 struct WindowBaResult {
-  std::vector<SE3> T_world_lidar;  // the knots, the first one as given
+  std::vector<SE3> T_world_lidar;  // the poses (knots at the given stamps), the first one as given
   int rounds = 0;
   size_t patches = 0, residuals = 0;  // of the last round
   // The points' distances to their planes (m), over the residuals of the first and the last
   // round: the map's crispness before and after.
   double rms_before_m = 0, rms_after_m = 0;
-  // With step_covariances: the motion from knot k to knot k + 1 (one fewer than the knots), in
-  // the odometry's convention (types.h: rotation first, the motion perturbed on the left, in knot
-  // k's frame), from the last round's information with the planes marginalized, scaled up by the
-  // residuals' variance over point_sigma_m^2 when that is larger than 1. Empty when the
-  // information is singular (a knot no point depends on, a scene without planes enough).
+  // With step_covariances: the motion from scan k's pose to scan k + 1's, and from the last
+  // scan's to the last pose (one a scan; with consecutive scans, one a pair of consecutive
+  // poses), in the odometry's convention (types.h: rotation first, the motion perturbed on the
+  // left, in the first pose's frame), from the last round's information with the planes
+  // marginalized, scaled up by the residuals' variance over point_sigma_m^2 when that is larger
+  // than 1. Empty when the information is singular (a knot no point depends on, a scene without
+  // planes enough).
   std::vector<Matrix6d> step_covariance;
   // With the photometric term: its residuals, and their noise as measured before its solve
   // (1.4826 median absolute deviations), by which each is weighed.
@@ -95,10 +98,31 @@ struct WindowBaResult {
   double photometric_sigma_range_m = 0, photometric_sigma_intensity = 0;
 };
 
+// A motion between two consecutive poses of a window measured by another sensor, with its
+// covariance (types.h's convention): the odometry's across a gap between keyframes, where each
+// side sees its knot through half a sweep's points only (a sweep's end knot holds the points of
+// its last half, the next keyframe's first knot those of its first half).
+struct MotionPrior {
+  size_t pose = 0;  // the motion from this pose to the next
+  SE3 T_pose_next;
+  Matrix6d covariance = Matrix6d::Identity();
+};
+
 // `scans`: in time order, each point in the sensor frame at its own time (Scan::point_times false,
-// or sweep_motion false: at the scan's stamp); `T_world_lidar`: the initial knots, one a scan and
-// the last at `end` (the end of the last sweep: the next scan's stamp). A knot no point depends on
-// (the last, when the scans have no times) comes back as given.
+// or sweep_motion false: at the scan's stamp); `stamps` and `T_world_lidar`: the window's poses
+// (the initial knots), in time order: each scan's stamp and the end of its sweep (the next scan's
+// stamp in the recording). Consecutive scans share the pose between them; where the window leaves
+// scans out (keyframes, sequence_ba.h) a sweep's end is a pose of its own, and the motion across
+// the gap to the next scan is what the two sweeps' points on common planes make of it. A knot no
+// point depends on comes back as given. `priors`: motions across gaps (MotionPrior), in the
+// solve and in the step covariances. Throws rigcal::Error when a scan has no pose at its stamp or
+// none after it, or a pose is neither a scan's stamp nor a sweep's end.
+WindowBaResult window_ba(const std::vector<Scan>& scans, const std::vector<Time>& stamps,
+                         const std::vector<SE3>& T_world_lidar, const WindowBaConfig& config,
+                         const std::vector<MotionPrior>& priors = {});
+
+// Consecutive scans: the poses at the scans' stamps and at `end` (the end of the last sweep: the
+// next scan's stamp).
 WindowBaResult window_ba(const std::vector<Scan>& scans, const std::vector<SE3>& T_world_lidar,
                          Time end, const WindowBaConfig& config);
 

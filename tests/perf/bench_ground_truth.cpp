@@ -156,6 +156,7 @@ void BM_BundleAdjustment(benchmark::State& state) {
     state.counters["stage_s"] = wall - sweep_seconds;
     state.counters["s_per_sweep"] = (wall - sweep_seconds) / double(made);
     state.counters["windows"] = double(ba.windows.size());
+    state.counters["keyframes"] = double(ba.keyframes.size());
   }
 }
 BENCHMARK(BM_BundleAdjustment)
