@@ -31,8 +31,8 @@ struct Windows {
   }
 };
 
-std::vector<size_t> keyframes(const Trajectory& T_world_lidar, const SequenceBaConfig& c) {
-  const size_t n = T_world_lidar.size();
+std::vector<size_t> keyframes(const Trajectory& T_odom_lidar, const SequenceBaConfig& c) {
+  const size_t n = T_odom_lidar.size();
   std::vector<size_t> out;
   if (n < 2) return out;
   const bool every = !(c.keyframe_distance_m > 0) && !(c.keyframe_angle_deg > 0);
@@ -40,8 +40,8 @@ std::vector<size_t> keyframes(const Trajectory& T_world_lidar, const SequenceBaC
   out.push_back(0);
   for (size_t k = 1; k + 1 < n; ++k) {
     const SE3 T_key_k =
-        T_world_lidar.T_world_body[out.back()].inverse() * T_world_lidar.T_world_body[k];
-    if (every || k - out.back() >= std::max<size_t>(1, c.keyframe_max_gap) ||
+        T_odom_lidar.T_world_body[out.back()].inverse() * T_odom_lidar.T_world_body[k];
+    if (every || (c.keyframe_max_gap > 0 && k - out.back() >= c.keyframe_max_gap) ||
         (c.keyframe_distance_m > 0 && T_key_k.t.norm() >= c.keyframe_distance_m) ||
         (c.keyframe_angle_deg > 0 && rotation_angle(T_key_k.R) >= angle_rad))
       out.push_back(k);
@@ -51,14 +51,18 @@ std::vector<size_t> keyframes(const Trajectory& T_world_lidar, const SequenceBaC
   return out;
 }
 
-Windows plan_windows(const Trajectory& T_world_lidar, const SequenceBaConfig& c) {
+Windows plan_windows(const Trajectory& T_odom_lidar, const SequenceBaConfig& c) {
   if (c.window_scans < 2 || c.overlap_scans >= c.window_scans)
     throw Error(fmt::format(
         "bundle adjustment: windows of {} scans overlapping by {}: at least 2 scans a window, "
         "and an overlap below that",
         c.window_scans, c.overlap_scans));
   Windows w;
-  w.keyframes = keyframes(T_world_lidar, c);
+  if (c.overlap_scans == 0 && (c.keyframe_distance_m > 0 || c.keyframe_angle_deg > 0))
+    throw Error(
+        "bundle adjustment: keyframes need windows that overlap by one keyframe at least (the "
+        "motion from a window's last keyframe to the next is the next window's)");
+  w.keyframes = keyframes(T_odom_lidar, c);
   const size_t nk = w.keyframes.size();
   for (size_t key : w.keyframes) {
     if (w.poses.empty() || w.poses.back() != key) w.poses.push_back(key);
@@ -73,13 +77,15 @@ Windows plan_windows(const Trajectory& T_world_lidar, const SequenceBaConfig& c)
     if (w.end.back() == nk) break;
   }
   // A window owns its motions from the middle of its overlap with the previous one to the middle
-  // of its overlap with the next, each from one keyframe to the next within it (the previous
-  // window's last keyframe's motion ends at its sweep's end, not at the next keyframe).
+  // of its overlap with the next, each from one keyframe to the next within it (where a gap
+  // follows the previous window's last keyframe, its motion ends at its sweep's end, not at the
+  // next keyframe: the next window's).
   w.owner.assign(nk, 0);
   for (size_t i = 1; i < w.first.size(); ++i) {
-    const size_t from =
-        std::max(w.first[i], std::min((w.first[i] + w.end[i - 1] + 1) / 2, w.end[i - 1] - 1));
-    for (size_t j = from; j < nk; ++j) w.owner[j] = i;
+    const size_t last = w.end[i - 1] - 1;  // the previous window's last keyframe
+    size_t from = (w.first[i] + w.end[i - 1] + 1) / 2;
+    if (w.keyframes[last + 1] != w.keyframes[last] + 1) from = std::min(from, last);
+    for (size_t j = std::max(from, w.first[i]); j < nk; ++j) w.owner[j] = i;
   }
   return w;
 }
@@ -91,7 +97,7 @@ Windows plan_windows(const Trajectory& T_world_lidar, const SequenceBaConfig& c)
 // window's. The poses inside the gap are off as well by the odometry's error bridged between its
 // ends (k steps in: k (m - k) / m of a step's variance, m / 4 at most), which a chain cannot hold
 // without loosening every gap by m - 1 steps of the odometry (tried: the demo's walk then
-// 13.1 mm from the truth instead of 3.5, doc/ground-truth.md); their sigmas leave it out.
+// 13.1 mm from the truth instead of 2.7, doc/ground-truth.md); their sigmas leave it out.
 void split_across_gap(const OdometryInput& odometry, size_t a, size_t b, const SE3& T_a_b,
                       const Matrix6d& covariance, std::vector<SE3>& motion,
                       std::vector<Matrix6d>& step_covariance) {
@@ -126,7 +132,7 @@ SequenceBaResult sequence_ba(const std::function<std::optional<Scan>()>& next_sc
   SequenceBaResult out;
   out.config = config;
   if (n < 2) return out;
-  const Windows plan = plan_windows(T_world_lidar, config);
+  const Windows plan = plan_windows(odometry.T_odom_lidar, config);
   out.planned_windows = plan.first.size();
   out.keyframes = plan.keyframes;
   // The chunk's windows, and the motions they own.
@@ -265,10 +271,10 @@ SequenceBaResult sequence_ba(const std::function<std::optional<Scan>()>& next_sc
   return out;
 }
 
-std::optional<size_t> first_pose_of_window(const Trajectory& T_world_lidar,
+std::optional<size_t> first_pose_of_window(const Trajectory& T_odom_lidar,
                                            const SequenceBaConfig& config, size_t window) {
-  if (T_world_lidar.size() < 2) return std::nullopt;
-  const Windows plan = plan_windows(T_world_lidar, config);
+  if (T_odom_lidar.size() < 2) return std::nullopt;
+  const Windows plan = plan_windows(T_odom_lidar, config);
   if (window >= plan.first.size()) return std::nullopt;
   return plan.keyframes[plan.first[window]];
 }

@@ -1,10 +1,10 @@
 #pragma once
 // The bundle adjustment of a whole sequence (doc/ground-truth.md, stage 2): keyframes chosen by
 // the rig's motion, overlapping windows of consecutive keyframes, each adjusted on its own
-// (window_ba.h), their results joined by the pose graph of stage 1. Each motion between the
-// windows' poses (a keyframe's stamp, its sweep's end) is taken from the one window in which it
-// lies farthest from the window's ends, with the covariance that window's information gives it;
-// a motion across the scans between two keyframes is spread over them along the odometry's path.
+// (window_ba.h), their results joined by the pose graph of stage 1. Each motion from one keyframe
+// to the next is taken from the one window in which it lies farthest from the window's ends, with
+// the covariance that window's information gives it, and spread over the scans between them
+// along the odometry's path (with every scan a keyframe, the default, each motion a scan's).
 // The pose graph then weighs these motions against the GNSS priors as it weighed the odometry's.
 // The windows are independent of each other, so the cost grows linearly with the sequence and the
 // memory holds one window of scans.
@@ -24,8 +24,10 @@ namespace rigcal::gt {
 struct SequenceBaConfig {
   WindowBaConfig window;  // its step_covariances is set here
   // Keyframes, the scans the windows adjust: the first scan, then each scan at which the rig has
-  // moved keyframe_distance_m or turned keyframe_angle_deg since the last keyframe (by the stage-1
-  // poses), or keyframe_max_gap scans after it, and the last sweep. Both 0 (the default): every
+  // moved keyframe_distance_m or turned keyframe_angle_deg since the last keyframe (by the
+  // odometry's motions: the same plan in every task of a job array), or keyframe_max_gap scans
+  // after it (0: no limit), and the last sweep. Windows must then overlap by one keyframe at
+  // least (overlap_scans). Both 0 (the default): every
   // scan. Keyframes trade accuracy for time: at 0.3 m and 5 deg a walk's 0.13 m a sweep makes
   // every third scan a keyframe, the adjustment about twice as fast, and the ground truth's error
   // larger, most where the scene holds the motion least (a corridor: doc/ground-truth.md).
@@ -44,7 +46,7 @@ struct SequenceBaConfig {
 
 // One window as it was adjusted (WindowBaResult's figures).
 struct WindowSummary {
-  size_t first_pose = 0, scans = 0;
+  size_t first_pose = 0, scans = 0;  // scans: the window's keyframes
   int rounds = 0;
   size_t patches = 0, residuals = 0;
   double rms_before_m = 0, rms_after_m = 0;
@@ -80,10 +82,10 @@ SequenceBaResult sequence_ba(const std::function<std::optional<Scan>()>& next_sc
                              const Trajectory& T_world_lidar, const OdometryInput& odometry,
                              const SequenceBaConfig& config, const report::Progress& progress = {});
 
-// The first pose (scan) of window `window` of the plan of the sequence whose stage-1 poses are
-// `T_world_lidar` (none past the plan's end): where a chunk's scans start (what came before may
+// The first pose (scan) of window `window` of the plan of the sequence whose odometry is
+// `T_odom_lidar` (none past the plan's end): where a chunk's scans start (what came before may
 // be skipped unread).
-std::optional<size_t> first_pose_of_window(const Trajectory& T_world_lidar,
+std::optional<size_t> first_pose_of_window(const Trajectory& T_odom_lidar,
                                            const SequenceBaConfig& config, size_t window);
 
 // The motions a chunk's windows own (first_owned..end_owned), chained from the pose of

@@ -252,7 +252,7 @@ GroundTruthRun run_ground_truth(const StepInputs& in, const StepOptions& o,
     }
     lidar::ScanStream stream(in.scans);
     if (const std::optional<size_t> first =
-            first_pose_of_window(run.graph.T_enu_lidar, o.ba, o.ba.first_window);
+            first_pose_of_window(odometry.T_odom_lidar, o.ba, o.ba.first_window);
         chunk && first) {
       stream.skip_before(odometry.T_odom_lidar.stamps[*first]);
     }
@@ -423,7 +423,7 @@ nlohmann::json ground_truth_report(const GroundTruthRun& run, const StepInputs& 
       before.push_back(w.rms_before_m);
       after.push_back(w.rms_after_m);
       windows.push_back({{"first_pose", w.first_pose},
-                         {"keyframes", w.scans},
+                         {"scans", w.scans},
                          {"rounds", w.rounds},
                          {"patches", w.patches},
                          {"residuals", w.residuals},
@@ -447,8 +447,8 @@ nlohmann::json ground_truth_report(const GroundTruthRun& run, const StepInputs& 
     j["bundle_adjustment"] = {{"windows", ba.windows.size()},
                               {"keyframes", ba.keyframes.size()},
                               {"config",
-                               {{"window_keyframes", ba.config.window_scans},
-                                {"overlap_keyframes", ba.config.overlap_scans},
+                               {{"window_scans", ba.config.window_scans},
+                                {"overlap_scans", ba.config.overlap_scans},
                                 {"keyframe_distance_m", ba.config.keyframe_distance_m},
                                 {"keyframe_angle_deg", ba.config.keyframe_angle_deg},
                                 {"keyframe_max_gap", ba.config.keyframe_max_gap},

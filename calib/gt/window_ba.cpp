@@ -512,6 +512,8 @@ WindowBaResult window_ba(const std::vector<Scan>& scans, const std::vector<Time>
   out.rms_after_m = rms_distance(associate(world, config), world);
   if (config.step_covariances && last) {
     const double variance = std::pow(out.rms_after_m / config.point_sigma_m, 2);
+    // The scale is the points' (their residuals' spread over their sigma); it scales the motion
+    // priors' share of the information too, on the safe side.
     std::vector<size_t> scan_and_end_knots = scan_knot;
     scan_and_end_knots.push_back(pose_knot.back());
     std::vector<Eigen::Vector4d*> plane_blocks;

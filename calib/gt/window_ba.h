@@ -71,7 +71,8 @@ struct WindowBaConfig {
   int later_iterations = 4;
   // Rounds stop when no pose moved more than this (m, and the same in rad over 10 m).
   double converged_m = 1e-4;
-  // The covariance of each motion between consecutive knots (WindowBaResult::step_covariance).
+  // The covariance of each motion from a scan's pose to the next scan's
+  // (WindowBaResult::step_covariance).
   bool step_covariances = false;
   int threads = 0;  // of the solver; 0: one a core
   PhotometricConfig photometric;

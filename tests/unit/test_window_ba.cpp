@@ -654,6 +654,10 @@ TEST(SequenceBa, KeyframesChosenByMotionGiveEveryMotionWithHonestSigmas) {
   EXPECT_EQ(gt::first_pose_of_window(standing.T_odom_lidar, plan_only, 1).value(), 12u);
   EXPECT_EQ(gt::first_pose_of_window(standing.T_odom_lidar, plan_only, 2).value(), 24u);
   EXPECT_FALSE(gt::first_pose_of_window(standing.T_odom_lidar, plan_only, 3).has_value());
+  // Keyframes need overlapping windows: the motion from a window's last keyframe to the next is
+  // the next window's.
+  plan_only.overlap_scans = 0;
+  EXPECT_THROW(gt::first_pose_of_window(standing.T_odom_lidar, plan_only, 0), Error);
 }
 
 }  // namespace
