@@ -26,10 +26,18 @@ struct Windows {
   // owner[j]: the window the motion from keyframe j to keyframe j + 1 (the last keyframe: to its
   // sweep's end, the last pose) is taken from.
   std::vector<size_t> owner;
-  size_t span_end(size_t j) const {  // the pose the motion from keyframe j ends at
-    return j + 1 < keyframes.size() ? keyframes[j + 1] : keyframes[j] + 1;
+  // The motion from keyframe j ends at this index into `poses` (the next keyframe's, or the last
+  // keyframe's sweep's end), and so at the trajectory's pose span_end(j).
+  size_t span_end_pose(size_t j) const {
+    return j + 1 < keyframes.size() ? pose_of_key[j + 1] : pose_of_key[j] + 1;
   }
+  size_t span_end(size_t j) const { return poses[span_end_pose(j)]; }
 };
+
+// The motion of `T` from pose a to pose b.
+SE3 motion_between(const Trajectory& T, size_t a, size_t b) {
+  return T.T_world_body[a].inverse() * T.T_world_body[b];
+}
 
 std::vector<size_t> keyframes(const Trajectory& T_odom_lidar, const SequenceBaConfig& c) {
   const size_t n = T_odom_lidar.size();
@@ -94,10 +102,12 @@ Windows plan_windows(const Trajectory& T_odom_lidar, const SequenceBaConfig& c) 
 // keyframes, with its `covariance`: the odometry's path, bent to end at T_a_b (its difference
 // from the odometry's motion spread evenly over the m steps, motion_fraction), each step with an
 // equal share of the covariance, C / m, so that the chain's covariance across the gap is the
-// window's. The poses inside the gap are off as well by the odometry's error bridged between its
-// ends (k steps in: k (m - k) / m of a step's variance, m / 4 at most), which a chain cannot hold
-// without loosening every gap by m - 1 steps of the odometry (tried: the demo's walk then
-// 13.1 mm from the truth instead of 2.7, doc/ground-truth.md); their sigmas leave it out.
+// window's (a single step, every scan a keyframe, is the window's motion itself, not rebuilt
+// through the odometry's and back). The poses inside the gap are off as well by the odometry's
+// error bridged between its ends (k steps in: k (m - k) / m of a step's variance, m / 4 at most),
+// which a chain cannot hold without loosening every gap by m - 1 steps of the odometry (tried: the
+// demo's walk then 13.1 mm from the truth instead of 2.7, doc/ground-truth.md); their sigmas leave
+// it out.
 void split_across_gap(const OdometryInput& odometry, size_t a, size_t b, const SE3& T_a_b,
                       const Matrix6d& covariance, std::vector<SE3>& motion,
                       std::vector<Matrix6d>& step_covariance) {
@@ -106,13 +116,13 @@ void split_across_gap(const OdometryInput& odometry, size_t a, size_t b, const S
     step_covariance[a] = covariance;
     return;
   }
-  const std::vector<SE3>& T_odom = odometry.T_odom_lidar.T_world_body;
-  const SE3 bend = (T_odom[a].inverse() * T_odom[b]).inverse() * T_a_b;
+  const Trajectory& T_odom_lidar = odometry.T_odom_lidar;
+  const SE3 bend = motion_between(T_odom_lidar, a, b).inverse() * T_a_b;
   const double m = double(b - a);
   SE3 T_a_k;  // the path's pose at step k's start, from a
   for (size_t k = a; k < b; ++k) {
-    const SE3 T_a_next =
-        (T_odom[a].inverse() * T_odom[k + 1]) * lidar::motion_fraction(bend, double(k + 1 - a) / m);
+    const SE3 T_a_next = motion_between(T_odom_lidar, a, k + 1) *
+                         lidar::motion_fraction(bend, double(k + 1 - a) / m);
     motion[k] = T_a_k.inverse() * T_a_next;
     step_covariance[k] = covariance / m;
     T_a_k = T_a_next;
@@ -138,20 +148,14 @@ SequenceBaResult sequence_ba(const std::function<std::optional<Scan>()>& next_sc
   // The chunk's windows, and the motions they own.
   const size_t first_window = std::min(config.first_window, plan.first.size());
   const size_t end_window = std::clamp(config.end_window, first_window, plan.first.size());
-  std::vector<bool> owned_step(n - 1, false);
+  // (The owners increase along the keyframes: a chunk's motions are one run of steps.)
   for (size_t j = 0; j < plan.owner.size(); ++j) {
     if (plan.owner[j] < first_window || plan.owner[j] >= end_window) continue;
-    for (size_t k = plan.keyframes[j]; k < plan.span_end(j); ++k) owned_step[k] = true;
-  }
-  for (size_t k = 0; k + 1 < n; ++k) {
-    if (!owned_step[k]) continue;
-    if (out.end_owned == 0) out.first_owned = k;
-    out.end_owned = k + 1;
+    if (out.end_owned == 0) out.first_owned = plan.keyframes[j];
+    out.end_owned = plan.span_end(j);
   }
   std::map<int64_t, size_t> pose_of_stamp;
   for (size_t k = 0; k < n; ++k) pose_of_stamp[T_world_lidar.stamps[k].ns] = k;
-  std::vector<bool> keyframe(n, false);
-  for (size_t key : plan.keyframes) keyframe[key] = true;
 
   WindowBaConfig window_config = config.window;
   window_config.step_covariances = true;
@@ -182,7 +186,8 @@ SequenceBaResult sequence_ba(const std::function<std::optional<Scan>()>& next_sc
             "another recording?)",
             to_seconds_text(T_world_lidar.stamps[next_pose])));
       }
-      if (next_pose >= chunk_first_pose && keyframe[next_pose])
+      if (next_pose >= chunk_first_pose &&
+          std::binary_search(plan.keyframes.begin(), plan.keyframes.end(), next_pose))
         pending.emplace(next_pose, std::move(*scan));
       ++next_pose;
     }
@@ -212,8 +217,7 @@ SequenceBaResult sequence_ba(const std::function<std::optional<Scan>()>& next_sc
         if (g == plan.pose_last[i] || plan.poses[g + 1] == plan.poses[g] + 1) continue;
         MotionPrior& gap = gaps.emplace_back();
         gap.pose = g - plan.pose_first[i];
-        gap.T_pose_next = odometry.T_odom_lidar.T_world_body[plan.poses[g]].inverse() *
-                          odometry.T_odom_lidar.T_world_body[plan.poses[g + 1]];
+        gap.T_pose_next = motion_between(odometry.T_odom_lidar, plan.poses[g], plan.poses[g + 1]);
         gap.covariance.setZero();  // the steps' summed (they are short: their frames alike)
         for (size_t k = plan.poses[g]; k < plan.poses[g + 1]; ++k)
           gap.covariance += odometry.step_covariance[k];
@@ -231,12 +235,10 @@ SequenceBaResult sequence_ba(const std::function<std::optional<Scan>()>& next_sc
       if (ba.step_covariance.empty()) continue;
       for (size_t j = plan.first[i]; j < plan.end[i]; ++j) {
         if (plan.owner[j] != i) continue;
+        // A window owns only motions it holds whole (plan_windows).
         const size_t a = plan.keyframes[j], b = plan.span_end(j);
-        const size_t local_a = plan.pose_of_key[j] - plan.pose_first[i];
-        const size_t local_b =
-            j + 1 < plan.end[i] ? plan.pose_of_key[j + 1] - plan.pose_first[i] : local_a + 1;
-        if (plan.poses[plan.pose_first[i] + local_b] != b) continue;  // not whole in the window
-        const SE3 T_a_b = ba.T_world_lidar[local_a].inverse() * ba.T_world_lidar[local_b];
+        const SE3 T_a_b = ba.T_world_lidar[plan.pose_of_key[j] - plan.pose_first[i]].inverse() *
+                          ba.T_world_lidar[plan.span_end_pose(j) - plan.pose_first[i]];
         split_across_gap(odometry, a, b, T_a_b, ba.step_covariance[j - plan.first[i]], motion,
                          covariance);
         for (size_t k = a; k < b; ++k) from_window[k] = true;
@@ -258,8 +260,7 @@ SequenceBaResult sequence_ba(const std::function<std::optional<Scan>()>& next_sc
   chained.T_world_body = {T_world_lidar.T_world_body[0]};
   for (size_t k = 0; k + 1 < n; ++k) {
     if (!from_window[k]) {
-      motion[k] = odometry.T_odom_lidar.T_world_body[k].inverse() *
-                  odometry.T_odom_lidar.T_world_body[k + 1];
+      motion[k] = motion_between(odometry.T_odom_lidar, k, k + 1);
       covariance[k] = odometry.step_covariance[k];
       out.motions_from_odometry += k >= out.first_owned && k < out.end_owned;
     }
@@ -287,9 +288,8 @@ OdometryInput owned_motions(const SequenceBaResult& ba, const Trajectory& T_worl
       owned.T_odom_lidar.T_world_body.push_back(T_world_lidar.T_world_body[k]);
     }
     owned.T_odom_lidar.stamps.push_back(T.stamps[k + 1]);
-    owned.T_odom_lidar.T_world_body.push_back(
-        owned.T_odom_lidar.T_world_body.back() *
-        (T.T_world_body[k].inverse() * T.T_world_body[k + 1]));
+    owned.T_odom_lidar.T_world_body.push_back(owned.T_odom_lidar.T_world_body.back() *
+                                              motion_between(T, k, k + 1));
     owned.step_covariance.push_back(ba.motions.step_covariance[k]);
   }
   return owned;
@@ -339,7 +339,7 @@ SequenceBaResult join_window_motions(const std::vector<OdometryInput>& chunks,
   chained.T_world_body = {T_world_first};
   for (size_t k = 0; k + 1 < n; ++k) {
     if (!out.from_window[k]) {
-      motion[k] = T_odom_lidar.T_world_body[k].inverse() * T_odom_lidar.T_world_body[k + 1];
+      motion[k] = motion_between(T_odom_lidar, k, k + 1);
       covariance[k] = odometry.step_covariance[k];
       ++out.motions_from_odometry;
     }

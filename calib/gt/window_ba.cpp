@@ -154,9 +154,9 @@ void solve_knots(ceres::Problem& problem, std::vector<Eigen::Vector4d>& plane, s
 // eliminated (each plane's 3 x 3 block, its Schur complement onto the knots it touches), inverted
 // with the held first knot left out. A knot's tangent (KnotManifold) is half the rotation vector
 // (exp(2 d) R, on the left, in the world frame), then the world's translation. With the knots
-// perturbed so (phi, dt), the motion R_a' R_b, R_a' (t_b - t_a) is perturbed by e_rot = R_a' (phi_b
-// - phi_a) and e_t = R_a' (dt_b - dt_a) + R_a' [t_b - t_a]x phi_a, to first order. Empty when a
-// knot has no residual or the information is singular.
+// perturbed so (phi, dt), the motion R_a' R_b, R_a' (t_b - t_a) is perturbed by
+// e_rot = R_a' (phi_b - phi_a) and e_t = R_a' (dt_b - dt_a) + R_a' [t_b - t_a]x phi_a, to first
+// order. Empty when a knot has no residual or the information is singular.
 std::vector<Matrix6d> step_covariances(ceres::Problem& problem, std::vector<Knot>& x,
                                        const std::vector<Eigen::Vector4d*>& planes,
                                        const std::vector<size_t>& pose_knots, double scale) {
