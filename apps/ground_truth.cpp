@@ -115,8 +115,9 @@ void add_ground_truth(CLI::App& app) {
   cmd->add_option("--keyframes", o->words.keyframes,
                   "M,DEG: experimental, not for use: a scan is a keyframe of the bundle "
                   "adjustment once the rig moved M metres or turned DEG degrees since the last "
-                  "(default 0,0: every scan); 0.3,5 halves a walk's time and fails where the "
-                  "scene holds the motion poorly (doc/ground-truth.md, \"Keyframes\")")
+                  "(default 0,0: every scan); 0.3,5 halves a walk's time, and the scans between "
+                  "keyframes are only as good as the odometry there (up to 0.16 m off on the "
+                  "simulator's walks; doc/ground-truth.md, \"Keyframes\")")
       ->delimiter(',')
       ->check(CLI::Range(0.0, 1000.0));
   cmd->add_option("--window-scans", o->step.ba.window_scans, "keyframes a bundle-adjustment window")

@@ -143,6 +143,7 @@ SequenceBaResult sequence_ba(const std::function<std::optional<Scan>()>& next_sc
   out.config = config;
   if (n < 2) return out;
   const Windows plan = plan_windows(odometry.T_odom_lidar, config);
+  const bool keyed = plan.keyframes.size() + 1 < n;  // (every scan: n - 1 keyframes)
   out.planned_windows = plan.first.size();
   out.keyframes = plan.keyframes;
   // The chunk's windows, and the motions they own.
@@ -210,19 +211,22 @@ SequenceBaResult sequence_ba(const std::function<std::optional<Scan>()>& next_sc
       std::vector<SE3> knots;
       for (size_t j = plan.first[i]; j < plan.end[i]; ++j)
         scans.push_back(pending.at(plan.keyframes[j]));
-      std::vector<MotionPrior> gaps;  // the odometry's motion across each gap
+      // With keyframes, the odometry's motion from each of the window's poses to the next (across
+      // each gap, and over each keyframe's own sweep: a sweep whose end no next scan holds can
+      // stretch along what its planes leave free; on the simulator's stairs, by a metre).
+      std::vector<MotionPrior> priors;
       for (size_t g = plan.pose_first[i]; g <= plan.pose_last[i]; ++g) {
         stamps.push_back(T_world_lidar.stamps[plan.poses[g]]);
         knots.push_back(T_world_lidar.T_world_body[plan.poses[g]]);
-        if (g == plan.pose_last[i] || plan.poses[g + 1] == plan.poses[g] + 1) continue;
-        MotionPrior& gap = gaps.emplace_back();
-        gap.pose = g - plan.pose_first[i];
-        gap.T_pose_next = motion_between(odometry.T_odom_lidar, plan.poses[g], plan.poses[g + 1]);
-        gap.covariance.setZero();  // the steps' summed (they are short: their frames alike)
+        if (g == plan.pose_last[i] || !keyed) continue;
+        MotionPrior& prior = priors.emplace_back();
+        prior.pose = g - plan.pose_first[i];
+        prior.T_pose_next = motion_between(odometry.T_odom_lidar, plan.poses[g], plan.poses[g + 1]);
+        prior.covariance.setZero();  // the steps' summed (they are short: their frames alike)
         for (size_t k = plan.poses[g]; k < plan.poses[g + 1]; ++k)
-          gap.covariance += odometry.step_covariance[k];
+          prior.covariance += odometry.step_covariance[k];
       }
-      results[i - i0] = window_ba(scans, stamps, knots, window_config, gaps);
+      results[i - i0] = window_ba(scans, stamps, knots, window_config, priors);
       seconds[i - i0] =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - window_started).count();
     });

@@ -4,7 +4,8 @@
 // (window_ba.h), their results joined by the pose graph of stage 1. Each motion from one keyframe
 // to the next is taken from the one window in which it lies farthest from the window's ends, with
 // the covariance that window's information gives it, and spread over the scans between them
-// along the odometry's path (with every scan a keyframe, the default, each motion a scan's).
+// along the odometry's path (with every scan a keyframe, the default, each motion a scan's; with
+// keyframes, the odometry's motions between the window's poses are priors in it).
 // The pose graph then weighs these motions against the GNSS priors as it weighed the odometry's.
 // The windows are independent of each other, so the cost grows linearly with the sequence and the
 // memory holds one window of scans.
@@ -30,7 +31,7 @@ struct SequenceBaConfig {
   // least (overlap_scans). Both 0 (the default): every
   // scan. Keyframes trade accuracy for time: at 0.3 m and 5 deg a walk's 0.13 m a sweep makes
   // every third scan a keyframe, the adjustment about twice as fast, and the ground truth's error
-  // larger, most where the scene holds the motion least (a corridor: doc/ground-truth.md).
+  // larger: the scans between keyframes are where the odometry puts them (doc/ground-truth.md).
   double keyframe_distance_m = 0, keyframe_angle_deg = 0;
   size_t keyframe_max_gap = 10;
   size_t window_scans = 20;  // keyframes a window (its poses: each one's stamp and sweep's end)

@@ -100,9 +100,11 @@ struct WindowBaResult {
 };
 
 // A motion between two consecutive poses of a window measured by another sensor, with its
-// covariance (types.h's convention): the odometry's across a gap between keyframes, where each
-// side sees its knot through half a sweep's points only (a sweep's end knot holds the points of
-// its last half, the next keyframe's first knot those of its first half).
+// covariance (types.h's convention): the odometry's, where the window leaves scans out
+// (keyframes). Across a gap each side sees its knot through half a sweep's points only (a
+// sweep's end knot holds the points of its last half, the next keyframe's first knot those of
+// its first half), and a keyframe's own sweep, whose end no next scan's points hold, can stretch
+// along whatever its planes leave free.
 struct MotionPrior {
   size_t pose = 0;  // the motion from this pose to the next
   SE3 T_pose_next;

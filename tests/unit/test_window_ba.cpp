@@ -527,7 +527,9 @@ void expect_motions_better_and_honest(const WalkWithOdometry& walk, const gt::Se
   std::printf("\n");
   EXPECT_LT(rms(ba_t), ratio * rms(odo_t));
   EXPECT_LT(rms(ba_r), ratio * rms(odo_r));
-  if (honest) EXPECT_GE(double(within), 0.95 * double(components));
+  if (honest) {
+    EXPECT_GE(double(within), 0.95 * double(components));
+  }
 }
 
 // A job array: the plan of `whole` cut into chunks of windows ([first, end) each, the last one
@@ -631,15 +633,16 @@ TEST(SequenceBa, KeyframesChosenByMotionGiveEveryMotionWithHonestSigmas) {
   EXPECT_GE(ba.keyframes.size(), 8u);
   EXPECT_LE(ba.keyframes.size(), 15u);
   ASSERT_GE(ba.planned_windows, 3u);
-  // Between keyframes, the motions are the windows': better than the odometry's (0.59 of its
-  // error here; with every scan adjusted, about 0.3), honest.
+  // Between keyframes, the motions are the windows': better than the odometry's (a third of its
+  // error here, as with every scan adjusted; 0.59 without the odometry's prior on each
+  // keyframe's own sweep), honest.
   std::vector<size_t> keyframes = ba.keyframes;
   keyframes.push_back(30);
-  expect_motions_better_and_honest(walk, ba, keyframes, 0.7);
+  expect_motions_better_and_honest(walk, ba, keyframes, 0.5);
   // Each step inside a span between keyframes (the odometry's path bent to the window's motion
   // across the span) is about as good as the odometry's, but not honest: each carries an equal
   // share of the span's covariance, not the odometry's error bridged between the span's ends
-  // (80 % of the components within 3 sigma here, 12 sigma at worst; adding the bridge to each
+  // (74 % of the components within 3 sigma here, 13 sigma at worst; adding the bridge to each
   // step loosens the whole chain by it instead: tried, doc/ground-truth.md).
   std::vector<size_t> every(31);
   std::iota(every.begin(), every.end(), 0);
