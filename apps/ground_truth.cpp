@@ -115,8 +115,8 @@ void add_ground_truth(CLI::App& app) {
   cmd->add_option("--keyframes", o->words.keyframes,
                   "M,DEG: experimental, not for use: a scan is a keyframe of the bundle "
                   "adjustment once the rig moved M metres or turned DEG degrees since the last "
-                  "(default 0,0: every scan); 0.3,5 halves a walk's time, and the scans between "
-                  "keyframes are only as good as the odometry there (up to 0.16 m off on the "
+                  "(default 0,0: every scan); 0.3,5 halves a walk's time, and the ground truth is "
+                  "then only as good as the odometry between keyframes (up to 0.17 m off on the "
                   "simulator's walks; doc/ground-truth.md, \"Keyframes\")")
       ->delimiter(',')
       ->check(CLI::Range(0.0, 1000.0));

@@ -39,7 +39,7 @@ struct RelativePoseError {
 };
 
 // The same term on the bundle adjustment's knots (a quaternion x y z w, then the translation, in
-// one block): a window's motion across a gap between keyframes against the odometry's.
+// one block): a window's motion between two of its poses against the odometry's (keyframes).
 struct KnotMotionError {
   RelativePoseError error;
   template <class T>

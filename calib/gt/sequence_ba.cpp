@@ -144,6 +144,9 @@ SequenceBaResult sequence_ba(const std::function<std::optional<Scan>()>& next_sc
   if (n < 2) return out;
   const Windows plan = plan_windows(odometry.T_odom_lidar, config);
   const bool keyed = plan.keyframes.size() + 1 < n;  // (every scan: n - 1 keyframes)
+  auto is_keyframe = [&](size_t pose) {
+    return std::binary_search(plan.keyframes.begin(), plan.keyframes.end(), pose);
+  };
   out.planned_windows = plan.first.size();
   out.keyframes = plan.keyframes;
   // The chunk's windows, and the motions they own.
@@ -187,8 +190,7 @@ SequenceBaResult sequence_ba(const std::function<std::optional<Scan>()>& next_sc
             "another recording?)",
             to_seconds_text(T_world_lidar.stamps[next_pose])));
       }
-      if (next_pose >= chunk_first_pose &&
-          std::binary_search(plan.keyframes.begin(), plan.keyframes.end(), next_pose))
+      if (next_pose >= chunk_first_pose && is_keyframe(next_pose))
         pending.emplace(next_pose, std::move(*scan));
       ++next_pose;
     }
@@ -211,14 +213,17 @@ SequenceBaResult sequence_ba(const std::function<std::optional<Scan>()>& next_sc
       std::vector<SE3> knots;
       for (size_t j = plan.first[i]; j < plan.end[i]; ++j)
         scans.push_back(pending.at(plan.keyframes[j]));
-      // With keyframes, the odometry's motion from each of the window's poses to the next (across
-      // each gap, and over each keyframe's own sweep: a sweep whose end no next scan holds can
-      // stretch along what its planes leave free; on the simulator's stairs, by a metre).
+      // With keyframes, the odometry's motion from each of the window's poses to the next,
+      // across each gap and over each sweep a gap follows (a sweep whose end no next scan's
+      // points hold can stretch along what its planes leave free; on the simulator's stairs, by
+      // a metre), not over a sweep the next keyframe follows (as with every scan).
       std::vector<MotionPrior> priors;
       for (size_t g = plan.pose_first[i]; g <= plan.pose_last[i]; ++g) {
         stamps.push_back(T_world_lidar.stamps[plan.poses[g]]);
         knots.push_back(T_world_lidar.T_world_body[plan.poses[g]]);
-        if (g == plan.pose_last[i] || !keyed) continue;
+        if (g == plan.pose_last[i] || !keyed ||
+            (is_keyframe(plan.poses[g]) && is_keyframe(plan.poses[g + 1])))
+          continue;
         MotionPrior& prior = priors.emplace_back();
         prior.pose = g - plan.pose_first[i];
         prior.T_pose_next = motion_between(odometry.T_odom_lidar, plan.poses[g], plan.poses[g + 1]);

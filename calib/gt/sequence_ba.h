@@ -31,7 +31,8 @@ struct SequenceBaConfig {
   // least (overlap_scans). Both 0 (the default): every
   // scan. Keyframes trade accuracy for time: at 0.3 m and 5 deg a walk's 0.13 m a sweep makes
   // every third scan a keyframe, the adjustment about twice as fast, and the ground truth's error
-  // larger: the scans between keyframes are where the odometry puts them (doc/ground-truth.md).
+  // larger: the scans between keyframes are where the odometry puts them, and the keyframes
+  // follow its motions where their planes leave a direction free (doc/ground-truth.md).
   double keyframe_distance_m = 0, keyframe_angle_deg = 0;
   size_t keyframe_max_gap = 10;
   size_t window_scans = 20;  // keyframes a window (its poses: each one's stamp and sweep's end)

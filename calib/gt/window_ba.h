@@ -117,9 +117,10 @@ struct MotionPrior {
 // stamp in the recording). Consecutive scans share the pose between them; where the window leaves
 // scans out (keyframes, sequence_ba.h) a sweep's end is a pose of its own, and the motion across
 // the gap to the next scan is what the two sweeps' points on common planes make of it. A knot no
-// point depends on comes back as given. `priors`: motions across gaps (MotionPrior), in the
-// solve and in the step covariances. Throws rigcal::Error when a scan has no pose at its stamp or
-// none after it, or a pose is neither a scan's stamp nor a sweep's end.
+// point depends on comes back as given. `priors`: motions between consecutive poses measured
+// elsewhere (MotionPrior), in the solve and in the step covariances. Throws rigcal::Error when a
+// scan has no pose at its stamp or none after it, or a pose is neither a scan's stamp nor a sweep's
+// end.
 WindowBaResult window_ba(const std::vector<Scan>& scans, const std::vector<Time>& stamps,
                          const std::vector<SE3>& T_world_lidar, const WindowBaConfig& config,
                          const std::vector<MotionPrior>& priors = {});

@@ -616,9 +616,11 @@ TEST(SequenceBa, AWalksWindowsGiveMotionsBetterThanTheOdometrysWithHonestSigmas)
 
 // The walk with keyframes chosen by motion (0.3 m or 5 deg; the walk makes about 0.13 m a sweep): a
 // third of the scans adjusted, in windows of 6 keyframes overlapping by 2, the odometry's motion
-// across each gap a prior (an odometry as good as rigcal's on the demo's walk: 2 mm and 0.02 deg a
-// step; a sweep's end knot and the next keyframe's first knot each see half a sweep, and the planes
-// alone hold the gap between them poorly). Every motion still comes from a window (across a gap,
+// across each gap and over each sweep a gap follows a prior (an odometry as good as rigcal's on
+// the demo's walk, 2 mm and 0.02 deg a step, with honest covariances: it cannot show what an
+// odometry that errs beyond its covariance does, doc/ground-truth.md; a sweep's end knot and the
+// next keyframe's first knot each see half a sweep, and the planes alone hold the gap between
+// them poorly). Every motion still comes from a window (across a gap,
 // spread over its steps along the odometry's path); the job array's chunks start at keyframes.
 TEST(SequenceBa, KeyframesChosenByMotionGiveEveryMotionWithHonestSigmas) {
   WalkWithOdometry walk;
