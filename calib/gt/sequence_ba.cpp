@@ -43,7 +43,7 @@ std::vector<size_t> keyframes(const Trajectory& T_odom_lidar, const SequenceBaCo
   const size_t n = T_odom_lidar.size();
   std::vector<size_t> out;
   if (n < 2) return out;
-  const bool every = !(c.keyframe_distance_m > 0) && !(c.keyframe_angle_deg > 0);
+  const bool every = !c.keyframes_on();
   const double angle_rad = c.keyframe_angle_deg * M_PI / 180;
   out.push_back(0);
   for (size_t k = 1; k + 1 < n; ++k) {
@@ -66,7 +66,7 @@ Windows plan_windows(const Trajectory& T_odom_lidar, const SequenceBaConfig& c) 
         "and an overlap below that",
         c.window_scans, c.overlap_scans));
   Windows w;
-  if (c.overlap_scans == 0 && (c.keyframe_distance_m > 0 || c.keyframe_angle_deg > 0))
+  if (c.overlap_scans == 0 && c.keyframes_on())
     throw Error(
         "bundle adjustment: keyframes need windows that overlap by one keyframe at least (the "
         "motion from a window's last keyframe to the next is the next window's)");

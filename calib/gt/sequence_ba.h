@@ -35,6 +35,7 @@ struct SequenceBaConfig {
   // follow its motions where their planes leave a direction free (doc/ground-truth.md).
   double keyframe_distance_m = 0, keyframe_angle_deg = 0;
   size_t keyframe_max_gap = 10;
+  bool keyframes_on() const { return keyframe_distance_m > 0 || keyframe_angle_deg > 0; }
   size_t window_scans = 20;  // keyframes a window (its poses: each one's stamp and sweep's end)
   size_t overlap_scans = 4;  // each window starts this many keyframes before the previous one ends
   // Windows adjusted at once (each on one thread; the scans of all of them held); 0: one a core.

@@ -243,7 +243,7 @@ GroundTruthRun run_ground_truth(const StepInputs& in, const StepOptions& o,
     run.notes.push_back(
         "no scans given or found: no bundle adjustment, the trajectory is the pose graph's");
   } else {
-    if (o.ba.keyframe_distance_m > 0 || o.ba.keyframe_angle_deg > 0) {
+    if (o.ba.keyframes_on()) {
       run.notes.push_back(
           "bundle adjustment with keyframes (experimental): the motions between keyframes are the "
           "windows', the scans between them placed along the odometry's path, and the odometry's "
@@ -283,8 +283,7 @@ GroundTruthRun run_ground_truth(const StepInputs& in, const StepOptions& o,
     run.stage1 = std::move(run.graph);
     // With keyframes the windows hold the odometry's motions already (priors in them): fusing
     // them again would count the odometry twice in the gate, which takes the two as independent.
-    const bool keyframes = o.ba.keyframe_distance_m > 0 || o.ba.keyframe_angle_deg > 0;
-    if (o.fuse_odometry && !keyframes) {
+    if (o.fuse_odometry && !o.ba.keyframes_on()) {
       FusedMotions fused = fuse_motions(odometry, run.ba->motions);
       run.odometry_weight = std::move(fused.weight_a);
       run.fusion_disagreeing_fraction = fused.disagreeing_fraction;
