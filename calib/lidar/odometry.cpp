@@ -160,7 +160,7 @@ Step register_scan(Odometry& o, const Scan& scan) {
     // The second scan: the first one deskewed with the motion now known, the map rebuilt from
     // it, and the second registered again (twice: the motion improves with the map).
     for (int pass = 0; deskew && n == 1 && o.first_scan.point_times && pass < 2; ++pass) {
-      o.map.voxels.clear();
+      clear(o.map);
       add_points(o.map, lidar::deskew(o.first_scan.points, r.T_odom_lidar, period_s, true));
       r = registered(r.T_odom_lidar, r.T_odom_lidar);
     }

@@ -6,7 +6,6 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <optional>
-#include <unordered_map>
 #include <vector>
 
 namespace rigcal::lidar {
@@ -25,15 +24,29 @@ struct VoxelMap {
   // again from nearly the same place adds no geometry, only the range noise spread along the
   // rays (KISS-ICP's spacing).
   double min_point_spacing = 0.0;
-  std::unordered_map<Eigen::Vector3i, std::vector<Eigen::Vector3d>, VoxelHash> voxels;
+  // The voxels that hold points, each its key and its points in the order they were added, in an
+  // open-addressing table (a power of two slots, at most half of them used, linear probing; a
+  // slot without points is free): a lookup is a multiplication and, mostly, one slot read, where
+  // std::unordered_map divides by its prime bucket count and follows a chain of nodes (the
+  // lookups are most of the odometry's time; doc/performance.md).
+  struct Voxel {
+    Eigen::Vector3i key = Eigen::Vector3i::Zero();
+    std::vector<Eigen::Vector3d> points;
+  };
+  std::vector<Voxel> slots;
+  size_t voxels = 0;  // slots in use
 };
 
 Eigen::Vector3i voxel_of(const Eigen::Vector3d& p, double voxel_size);
 size_t point_count(const VoxelMap& map);
+// The points of voxel `key`, none when it holds none.
+const std::vector<Eigen::Vector3d>* voxel_points(const VoxelMap& map, const Eigen::Vector3i& key);
 // Adds points (odometry frame) to voxels not yet full.
 void add_points(VoxelMap& map, const std::vector<Eigen::Vector3d>& points_odom);
 // Drops the voxels whose first point is farther than `max_distance` from `origin_odom`.
 void remove_far(VoxelMap& map, const Eigen::Vector3d& origin_odom, double max_distance);
+// Drops every voxel (the settings kept).
+void clear(VoxelMap& map);
 
 // A plane through map points: unit normal, a point on it (their centroid), and how flat the
 // points lie (the smallest over the middle eigenvalue of their scatter, 0 for a perfect plane).

@@ -5,12 +5,14 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <random>
 
@@ -26,6 +28,7 @@
 #include "rigcal/io/trajectory_io.h"
 #include "rigcal/lidar/preprocess.h"
 #include "rigcal/lidar/step.h"
+#include "rigcal/lidar/voxel_map.h"
 #include "rigcal/rig/rig_yaml.h"
 #include "rigcal/sim/lidar.h"
 #include "rigcal/sim/session.h"
@@ -354,6 +357,109 @@ TEST(Degeneracy, ACorridorLeavesTheMotionAlongItFree) {
     EXPECT_GT(d.translation_sigma_max_m, 10 * std::sqrt(std::max(C_own(1, 1), C_own(2, 2)))) << k;
     EXPECT_GT(std::sqrt(C(0, 0)), 3 * std::abs(T_prev_cur.t.x() - 0.1)) << k;
   }
+}
+
+// The voxel map's table against a plain one (std::map of the voxels, each point kept in the order
+// added): the same points in each voxel and the same planes, through the table's growth from
+// its first 64 slots, the far voxels' removal and a clear; the planes come from the nearest
+// points, checked here by a search of every point.
+TEST(VoxelMap, HoldsAndFindsWhatAPlainMapOfTheVoxelsWould) {
+  VoxelMap map;
+  map.voxel_size = 0.5;
+  map.max_points_per_voxel = 6;
+  map.min_point_spacing = 0.02;
+  struct Less {
+    bool operator()(const Eigen::Vector3i& a, const Eigen::Vector3i& b) const {
+      return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+    }
+  };
+  std::map<Eigen::Vector3i, std::vector<Eigen::Vector3d>, Less> plain;
+  auto add_plain = [&](const std::vector<Eigen::Vector3d>& points) {
+    for (const Eigen::Vector3d& p : points) {
+      std::vector<Eigen::Vector3d>& v = plain[voxel_of(p, map.voxel_size)];
+      const bool near = std::any_of(v.begin(), v.end(), [&](const Eigen::Vector3d& q) {
+        return (q - p).norm() < map.min_point_spacing;
+      });
+      if (v.size() < map.max_points_per_voxel && !near) v.push_back(p);
+    }
+  };
+  auto same = [&](const char* when) {
+    size_t points = 0;
+    for (const auto& [key, v] : plain) {
+      const std::vector<Eigen::Vector3d>* found = voxel_points(map, key);
+      ASSERT_NE(found, nullptr) << when << " " << key.transpose();
+      EXPECT_EQ(*found, v) << when;
+      points += v.size();
+    }
+    EXPECT_EQ(map.voxels, plain.size()) << when;
+    EXPECT_EQ(point_count(map), points) << when;
+    EXPECT_EQ(voxel_points(map, Eigen::Vector3i(1000, 0, 0)), nullptr) << when;
+  };
+  // Points on two walls and a floor of a 12 m room, and noise off them.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-6.0, 6.0), noise(-0.005, 0.005);
+  auto room = [&](size_t n) {
+    std::vector<Eigen::Vector3d> points;
+    for (size_t i = 0; i < n; ++i) {
+      const double a = u(rng), b = u(rng) / 4 + 1.5;
+      points.push_back(i % 3 == 0   ? Eigen::Vector3d(a, b, noise(rng))
+                       : i % 3 == 1 ? Eigen::Vector3d(6 + noise(rng), a, b)
+                                    : Eigen::Vector3d(a, 6 + noise(rng), b));
+    }
+    return points;
+  };
+  const std::vector<Eigen::Vector3d> first = room(20000), second = room(20000);
+  add_points(map, first);
+  add_plain(first);
+  ASSERT_GT(map.voxels, 64u) << "the table grew";
+  same("added");
+  add_points(map, second);
+  add_plain(second);
+  same("added again");
+  // Each query's plane: its normal across the wall, and through the mean of its nearest points
+  // as a search of every map point finds them.
+  size_t planes = 0;
+  for (size_t i = 0; i < 300; ++i) {
+    const Eigen::Vector3d q = second[i] + Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+    const std::optional<Plane> plane = plane_near(map, q, 0.25, 8, 0.2);
+    if (!plane) continue;
+    ++planes;
+    std::vector<std::pair<double, Eigen::Vector3d>> all;
+    const Eigen::Vector3i home = voxel_of(q, map.voxel_size);
+    for (const auto& [key, v] : plain)
+      if ((key - home).cwiseAbs().maxCoeff() <= 1)
+        for (const Eigen::Vector3d& p : v)
+          if ((p - q).norm() <= 0.25 && ((p - q).cwiseAbs().array() < 0.5 * map.voxel_size).all())
+            all.push_back({(p - q).squaredNorm(), p});
+    std::sort(all.begin(), all.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    const size_t k_nearest = std::min<size_t>(all.size(), 8);  // 5 at least for a plane
+    ASSERT_GE(k_nearest, 5u);
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (size_t k = 0; k < k_nearest; ++k) mean += all[k].second / double(k_nearest);
+    EXPECT_LT((plane->point - mean).norm(), 1e-12) << q.transpose();
+    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+    for (size_t k = 0; k < k_nearest; ++k)
+      scatter += (all[k].second - mean) * (all[k].second - mean).transpose();
+    const Eigen::Vector3d normal =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(0);
+    EXPECT_GT(std::abs(plane->normal.dot(normal)), 1 - 1e-9) << q.transpose();
+  }
+  EXPECT_GT(planes, 250u);
+  // The voxels whose first point is more than 5 m from the corner (6, 6, 0) dropped.
+  const Eigen::Vector3d corner(6, 6, 0);
+  remove_far(map, corner, 5.0);
+  std::erase_if(plain, [&](const auto& e) { return (e.second.front() - corner).norm() > 5.0; });
+  ASSERT_FALSE(plain.empty());
+  same("far voxels removed");
+  clear(map);
+  EXPECT_EQ(map.voxels, 0u);
+  EXPECT_EQ(point_count(map), 0u);
+  EXPECT_EQ(voxel_points(map, voxel_of(first[0], map.voxel_size)), nullptr);
+  add_points(map, first);
+  plain.clear();
+  add_plain(first);
+  same("cleared and added");
 }
 
 TEST(OdometryIo, CovariancesReadBackAsWritten) {
