@@ -28,6 +28,8 @@ find_dependency(apriltag)
 # The image reader decodes JPEG itself and checks PNG chunk CRCs (calib/io/image_io.cpp).
 find_dependency(JPEG)
 find_dependency(ZLIB)
+# SHA-256 of the inputs (calib/core/sha256.cpp): libcrypto, with the CPU's SHA instructions.
+find_dependency(OpenSSL 3)
 
 # mrcal 2.2 ships no CMake or pkg-config file: one header folder and -lmrcal.
 if(NOT TARGET rigcal_mrcal)
